@@ -1,0 +1,47 @@
+// The face every engine shares: Options -> Engine(options, seed) -> feed(...) / estimate().
+#pragma once
+#include <string>
+
+#include <Eigen/Core>
+
+#include "pdnav/geo/frames.h"
+#include "pdnav/geo/units.h"
+
+namespace pdnav {
+
+enum class EngineKind { kNone, kDeadReckoning, kTerrain, kRoute, kGnss };
+const char* to_string(EngineKind k);
+
+enum class EstimateStatus {
+  kNotInitialized,  // no start position yet
+  kOk,              // tracking
+  kDegraded,        // tracking with reduced confidence (e.g. few satellites, flat terrain)
+  kAmbiguous,       // several hypotheses (route engine: needs a fix)
+  kLost,            // diverged or no hypotheses; waiting for a reset
+};
+const char* to_string(EstimateStatus s);
+
+/// 1-sigma / 2-sigma horizontal error ellipse from a 2x2 east/north covariance.
+struct ErrorEllipse {
+  double semi_major_m = 0.0;   // 1-sigma
+  double semi_minor_m = 0.0;   // 1-sigma
+  double orientation_rad = 0.0;  // of the major axis, clockwise from north
+  static ErrorEllipse from_covariance(const Eigen::Matrix2d& cov_en_m2);
+  /// Scale for a probability content in 2D: k = sqrt(-2 ln(1-p)) (e.g. 2.4477 for 95 %).
+  static double scale_for_probability(double p);
+};
+
+struct Estimate {
+  TimeNs t_ns = 0;
+  EngineKind engine = EngineKind::kNone;
+  EstimateStatus status = EstimateStatus::kNotInitialized;
+  std::string reason;                 // human-readable, e.g. "GNSS lost, terrain engine"
+  geo::Geodetic position;             // best estimate
+  Eigen::Vector2d en_m = Eigen::Vector2d::Zero();  // east/north in the engine's local frame
+  Eigen::Matrix2d cov_en_m2 = Eigen::Matrix2d::Identity();  // horizontal covariance
+  double vertical_sigma_m = 0.0;
+  bool valid() const { return status == EstimateStatus::kOk || status == EstimateStatus::kDegraded || status == EstimateStatus::kAmbiguous; }
+  ErrorEllipse ellipse() const { return ErrorEllipse::from_covariance(cov_en_m2); }
+};
+
+}  // namespace pdnav
