@@ -1,0 +1,219 @@
+#include "support/replay_support.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <stdexcept>
+
+namespace pdnav::cli {
+
+std::vector<double> parse_number_list(const std::string& text, const std::string& what) {
+  std::vector<double> out;
+  std::size_t pos = 0;
+  while (pos <= text.size()) {
+    const std::size_t comma = text.find(',', pos);
+    const std::string tok = text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+    try {
+      std::size_t used = 0;
+      const double v = std::stod(tok, &used);
+      if (used != tok.size() || !std::isfinite(v)) throw std::invalid_argument(tok);
+      out.push_back(v);
+    } catch (const std::exception&) {
+      throw std::invalid_argument(what + ": '" + tok + "' is not a number in '" + text + "'");
+    }
+    if (comma == std::string::npos) break;
+    pos = comma + 1;
+  }
+  return out;
+}
+
+void ProgressBar::update(double fraction) {
+  if (!out_) return;
+  const int pct = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 100.0);
+  if (pct == last_percent_) return;
+  last_percent_ = pct;
+  *out_ << "\r" << label_ << ": " << std::setw(3) << pct << " %" << std::flush;
+}
+
+void ProgressBar::done() {
+  if (out_ && last_percent_ >= 0) *out_ << "\r" << label_ << ": 100 %\n";
+}
+
+nlohmann::json ErrorStats::to_json() const {
+  return {{"epochs_with_reference", n}, {"drms_m", drms_m}, {"rms_e_m", rms_e_m}, {"rms_n_m", rms_n_m},
+          {"p50_horizontal_m", p50_h_m}, {"p95_horizontal_m", p95_h_m}, {"coverage_1sigma", coverage_1sigma}};
+}
+
+void ReplayRecorder::observe_reference(const Sample& s) {
+  if (const auto* t = std::get_if<TruthSample>(&s)) {
+    if (std::isfinite(t->lat_deg) && std::isfinite(t->lon_deg))
+      truth_.push_back({t->t_ns, geo::Geodetic::from_deg(t->lat_deg, t->lon_deg, std::isfinite(t->h_m) ? t->h_m : 0.0)});
+  } else if (const auto* f = std::get_if<FixSample>(&s)) {
+    std::string p = f->provider;
+    std::transform(p.begin(), p.end(), p.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+    if (p == "GPS" && std::isfinite(f->lat_deg) && std::isfinite(f->lon_deg))
+      fixes_.push_back({f->t_ns, geo::Geodetic::from_deg(f->lat_deg, f->lon_deg, std::isfinite(f->alt_m) ? f->alt_m : 0.0)});
+  }
+}
+
+void ReplayRecorder::observe_estimate(const Estimate& e) {
+  if (!e.valid()) return;
+  if (e.t_ns == last_t_ && e.status == last_status_) return;  // unchanged since the last sample
+  last_t_ = e.t_ns;
+  last_status_ = e.status;
+  Epoch ep;
+  ep.est = e;
+  epochs_.push_back(ep);
+}
+
+bool ReplayRecorder::reference_at(TimeNs t, geo::Geodetic* out) const {
+  if (truth_.size() >= 2) {
+    auto it = std::lower_bound(truth_.begin(), truth_.end(), t, [](const Ref& r, TimeNs x) { return r.t_ns < x; });
+    if (it == truth_.end() || it == truth_.begin()) {
+      const Ref& r = it == truth_.end() ? truth_.back() : truth_.front();
+      if (std::llabs(r.t_ns - t) > kNsPerS) return false;
+      *out = r.p;
+      return true;
+    }
+    const Ref& b = *it;
+    const Ref& a = *(it - 1);
+    const double w = b.t_ns == a.t_ns ? 0.0 : static_cast<double>(t - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
+    *out = geo::Geodetic{a.p.lat_rad + w * (b.p.lat_rad - a.p.lat_rad), a.p.lon_rad + w * (b.p.lon_rad - a.p.lon_rad),
+                         a.p.h_m + w * (b.p.h_m - a.p.h_m)};
+    return true;
+  }
+  if (!fixes_.empty()) {
+    auto it = std::lower_bound(fixes_.begin(), fixes_.end(), t, [](const Ref& r, TimeNs x) { return r.t_ns < x; });
+    const Ref* best = nullptr;
+    if (it != fixes_.end()) best = &*it;
+    if (it != fixes_.begin() && (!best || std::llabs((it - 1)->t_ns - t) < std::llabs(best->t_ns - t))) best = &*(it - 1);
+    if (best && std::llabs(best->t_ns - t) <= kNsPerS) {
+      *out = best->p;
+      return true;
+    }
+  }
+  return false;
+}
+
+void ReplayRecorder::finish() {
+  std::sort(truth_.begin(), truth_.end(), [](const Ref& a, const Ref& b) { return a.t_ns < b.t_ns; });
+  std::sort(fixes_.begin(), fixes_.end(), [](const Ref& a, const Ref& b) { return a.t_ns < b.t_ns; });
+  for (Epoch& ep : epochs_) {
+    geo::Geodetic ref;
+    if (!reference_at(ep.est.t_ns, &ref)) continue;
+    ep.has_ref = true;
+    ep.ref = ref;
+    const geo::Enu d = geo::LocalFrame(ref).to_enu(ep.est.position);
+    ep.err_e_m = d.e_m();
+    ep.err_n_m = d.n_m();
+    const Eigen::Vector2d err(ep.err_e_m, ep.err_n_m);
+    const Eigen::Matrix2d cov = ep.est.cov_en_m2;
+    // inside the 1-sigma ellipse: Mahalanobis distance^2 <= 1 (39.3 % nominal in 2D)
+    ep.inside_1sigma = cov.determinant() > 0 && err.dot(cov.inverse() * err) <= 1.0;
+  }
+}
+
+std::map<std::string, std::int64_t> ReplayRecorder::epochs_by_engine() const {
+  std::map<std::string, std::int64_t> m;
+  for (const Epoch& e : epochs_) ++m[to_string(e.est.engine)];
+  return m;
+}
+
+std::string ReplayRecorder::reference_kind() const {
+  if (truth_.size() >= 2) return "truth";
+  if (!fixes_.empty()) return "gps-fix";
+  return "none";
+}
+
+ErrorStats ReplayRecorder::error_stats() const {
+  ErrorStats s;
+  std::vector<double> h;
+  double se = 0, sn = 0;
+  std::int64_t inside = 0;
+  for (const Epoch& e : epochs_) {
+    if (!e.has_ref) continue;
+    ++s.n;
+    se += e.err_e_m * e.err_e_m;
+    sn += e.err_n_m * e.err_n_m;
+    h.push_back(std::hypot(e.err_e_m, e.err_n_m));
+    inside += e.inside_1sigma ? 1 : 0;
+  }
+  if (s.n == 0) return s;
+  const double n = static_cast<double>(s.n);
+  s.rms_e_m = std::sqrt(se / n);
+  s.rms_n_m = std::sqrt(sn / n);
+  s.drms_m = std::sqrt((se + sn) / n);
+  std::sort(h.begin(), h.end());
+  auto pct = [&](double p) { return h[std::min(h.size() - 1, static_cast<std::size_t>(p * static_cast<double>(h.size() - 1) + 0.5))]; };
+  s.p50_h_m = pct(0.50);
+  s.p95_h_m = pct(0.95);
+  s.coverage_1sigma = static_cast<double>(inside) / n;
+  return s;
+}
+
+void ReplayRecorder::write_track_csv(const std::string& path) const {
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot create");
+  f << "t_ns,engine,status,lat_deg,lon_deg,h_m,e_m,n_m,cov_ee_m2,cov_en_m2,cov_nn_m2,semi_major_m,semi_minor_m,"
+       "orientation_deg,ref_lat_deg,ref_lon_deg,err_e_m,err_n_m,reason\n";
+  f << std::setprecision(12);
+  for (const Epoch& ep : epochs_) {
+    const Estimate& e = ep.est;
+    const ErrorEllipse el = e.ellipse();
+    f << e.t_ns << ',' << to_string(e.engine) << ',' << to_string(e.status) << ',' << e.position.lat_deg() << ','
+      << e.position.lon_deg() << ',' << e.position.h_m << ',' << e.en_m.x() << ',' << e.en_m.y() << ','
+      << e.cov_en_m2(0, 0) << ',' << e.cov_en_m2(0, 1) << ',' << e.cov_en_m2(1, 1) << ',' << el.semi_major_m << ','
+      << el.semi_minor_m << ',' << rad_to_deg(el.orientation_rad) << ',';
+    if (ep.has_ref)
+      f << ep.ref.lat_deg() << ',' << ep.ref.lon_deg() << ',' << ep.err_e_m << ',' << ep.err_n_m;
+    else
+      f << ",,,";
+    std::string reason = e.reason;
+    std::replace(reason.begin(), reason.end(), ',', ';');
+    f << ',' << reason << '\n';
+  }
+}
+
+std::vector<std::pair<double, double>> ellipse_polygon(const Estimate& e, double k, int points) {
+  const ErrorEllipse el = e.ellipse();
+  const geo::LocalFrame frame(e.position);
+  std::vector<std::pair<double, double>> ring;
+  for (int i = 0; i <= points; ++i) {
+    const double a = 2.0 * kPi * i / points;
+    const double u = k * el.semi_major_m * std::cos(a), v = k * el.semi_minor_m * std::sin(a);
+    // major axis at orientation (clockwise from north): unit (sin, cos); minor perpendicular
+    const double so = std::sin(el.orientation_rad), co = std::cos(el.orientation_rad);
+    const double east = u * so + v * co, north = u * co - v * so;
+    const geo::Geodetic g = frame.to_geodetic(geo::Enu(east, north, 0.0));
+    ring.emplace_back(g.lon_deg(), g.lat_deg());
+  }
+  return ring;
+}
+
+void ReplayRecorder::write_geojson(const std::string& path, std::size_t max_ellipses) const {
+  nlohmann::json features = nlohmann::json::array();
+  nlohmann::json line = nlohmann::json::array();
+  for (const Epoch& ep : epochs_) line.push_back({ep.est.position.lon_deg(), ep.est.position.lat_deg()});
+  features.push_back({{"type", "Feature"},
+                      {"properties", {{"kind", "track"}}},
+                      {"geometry", {{"type", "LineString"}, {"coordinates", line}}}});
+  const std::size_t stride = std::max<std::size_t>(1, epochs_.size() / std::max<std::size_t>(1, max_ellipses));
+  for (std::size_t i = 0; i < epochs_.size(); i += stride) {
+    const Estimate& e = epochs_[i].est;
+    const ErrorEllipse el = e.ellipse();
+    if (!std::isfinite(el.semi_major_m)) continue;
+    nlohmann::json ring = nlohmann::json::array();
+    for (const auto& [lon, lat] : ellipse_polygon(e, 1.0)) ring.push_back({lon, lat});
+    features.push_back({{"type", "Feature"},
+                        {"properties", {{"kind", "ellipse-1sigma"}, {"t_ns", e.t_ns}, {"engine", to_string(e.engine)},
+                                        {"status", to_string(e.status)}, {"semi_major_m", el.semi_major_m},
+                                        {"semi_minor_m", el.semi_minor_m}}},
+                        {"geometry", {{"type", "Polygon"}, {"coordinates", nlohmann::json::array({ring})}}}});
+  }
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot create");
+  f << nlohmann::json({{"type", "FeatureCollection"}, {"features", features}}).dump() << "\n";
+}
+
+}  // namespace pdnav::cli

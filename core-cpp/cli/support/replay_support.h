@@ -1,0 +1,81 @@
+// Helpers of the replay command: progress bar, reference tracking, track/GeoJSON writers
+// and error statistics against a reference (ground truth or the phone's GPS fixes).
+#pragma once
+#include <cstdint>
+#include <map>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pdnav/geo/estimate.h"
+#include "pdnav/geo/frames.h"
+#include "pdnav/geo/samples.h"
+
+namespace pdnav::cli {
+
+/// "1.5,2,3" -> {1.5, 2, 3}; throws std::invalid_argument naming the option on bad input.
+std::vector<double> parse_number_list(const std::string& text, const std::string& what);
+
+/// A one-line progress indicator on a terminal stream (nothing when out is null).
+class ProgressBar {
+ public:
+  ProgressBar(std::ostream* out, std::string label) : out_(out), label_(std::move(label)) {}
+  void update(double fraction);
+  void done();
+
+ private:
+  std::ostream* out_;
+  std::string label_;
+  int last_percent_ = -1;
+};
+
+struct ErrorStats {
+  std::int64_t n = 0;
+  double drms_m = 0.0;       // sqrt(mean(e^2 + n^2))
+  double rms_e_m = 0.0;
+  double rms_n_m = 0.0;
+  double p50_h_m = 0.0;
+  double p95_h_m = 0.0;
+  double coverage_1sigma = 0.0;  // fraction of epochs inside the 1-sigma ellipse
+  nlohmann::json to_json() const;
+};
+
+/// One output epoch of the replay.
+struct Epoch {
+  Estimate est;
+  bool has_ref = false;
+  geo::Geodetic ref;
+  double err_e_m = 0.0, err_n_m = 0.0;
+  bool inside_1sigma = false;
+};
+
+/// Collects reference positions and estimates during a replay.
+class ReplayRecorder {
+ public:
+  void observe_reference(const Sample& s);
+  void observe_estimate(const Estimate& e);
+  /// Attach references to epochs (interpolated truth, or the nearest GPS fix within 1 s).
+  void finish();
+  const std::vector<Epoch>& epochs() const { return epochs_; }
+  std::map<std::string, std::int64_t> epochs_by_engine() const;
+  ErrorStats error_stats() const;
+  std::string reference_kind() const;
+  void write_track_csv(const std::string& path) const;
+  void write_geojson(const std::string& path, std::size_t max_ellipses = 400) const;
+
+ private:
+  struct Ref { TimeNs t_ns; geo::Geodetic p; };
+  bool reference_at(TimeNs t, geo::Geodetic* out) const;
+  std::vector<Ref> truth_;
+  std::vector<Ref> fixes_;
+  std::vector<Epoch> epochs_;
+  TimeNs last_t_ = -1;
+  EstimateStatus last_status_ = EstimateStatus::kNotInitialized;
+};
+
+/// Ellipse outline (lon, lat) polygon for an estimate at probability scale k (1 = 1-sigma).
+std::vector<std::pair<double, double>> ellipse_polygon(const Estimate& e, double k, int points = 36);
+
+}  // namespace pdnav::cli

@@ -1,0 +1,241 @@
+#!/usr/bin/python3
+"""pdnav plotting tool: figures a field tester wants from a replay output directory.
+
+  tools/plot.py replay OUT_DIR [--background RASTER] [--title T]
+      track.png  estimated track, reference track, 1-sigma ellipses (over hillshaded terrain
+                 when a GDAL-readable RASTER is given, e.g. /vsizip/N42E001.hgt.zip/N42E001.hgt)
+      error.png  horizontal error vs time with the predicted 1-sigma and 2-sigma radius
+                 (the layout of Broyles et al. 2018, Figs. 8-10)
+  tools/plot.py gnss CSV [--out DIR]
+      gnss_track.png, gnss_error.png, gnss_sats.png from `pdnav gnss --out CSV`
+
+Uses Debian's python3-matplotlib / python3-numpy / python3-gdal (tools/setup installs them).
+"""
+import argparse
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+R_EARTH_M = 6378137.0
+
+
+def read_csv(path):
+    if not os.path.exists(path):
+        sys.exit(f"plot: {path}: no such file")
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        sys.exit(f"plot: {path}: no rows to plot")
+    return rows
+
+
+def col(rows, name, default=float("nan")):
+    out = []
+    for r in rows:
+        v = r.get(name, "")
+        try:
+            out.append(float(v) if v not in ("", None) else default)
+        except ValueError:
+            out.append(default)
+    return np.array(out)
+
+
+def local_en(lat, lon, lat0, lon0):
+    e = np.radians(lon - lon0) * R_EARTH_M * math.cos(math.radians(lat0))
+    n = np.radians(lat - lat0) * R_EARTH_M
+    return e, n
+
+
+def hillshade_background(ax, raster, lat0, lon0, extent_en):
+    try:
+        from osgeo import gdal
+    except ImportError:
+        print("plot: python3-gdal missing, no terrain background", file=sys.stderr)
+        return
+    gdal.UseExceptions()
+    ds = gdal.Open(raster)
+    gt = ds.GetGeoTransform()
+    band = ds.GetRasterBand(1)
+    e_min, e_max, n_min, n_max = extent_en
+    lon_min = lon0 + math.degrees(e_min / (R_EARTH_M * math.cos(math.radians(lat0))))
+    lon_max = lon0 + math.degrees(e_max / (R_EARTH_M * math.cos(math.radians(lat0))))
+    lat_min = lat0 + math.degrees(n_min / R_EARTH_M)
+    lat_max = lat0 + math.degrees(n_max / R_EARTH_M)
+    x0 = int(max(0, math.floor((lon_min - gt[0]) / gt[1])))
+    x1 = int(min(ds.RasterXSize, math.ceil((lon_max - gt[0]) / gt[1]) + 1))
+    y0 = int(max(0, math.floor((lat_max - gt[3]) / gt[5])))
+    y1 = int(min(ds.RasterYSize, math.ceil((lat_min - gt[3]) / gt[5]) + 1))
+    if x1 - x0 < 2 or y1 - y0 < 2:
+        print("plot: track is outside the background raster", file=sys.stderr)
+        return
+    z = band.ReadAsArray(x0, y0, x1 - x0, y1 - y0).astype(float)
+    nodata = band.GetNoDataValue()
+    if nodata is not None:
+        z[z == nodata] = np.nan
+    dx = gt[1] * math.pi / 180 * R_EARTH_M * math.cos(math.radians(lat0))
+    dy = -gt[5] * math.pi / 180 * R_EARTH_M
+    gy, gx = np.gradient(z, dy, dx)
+    slope = np.arctan(np.hypot(gx, gy))
+    aspect = np.arctan2(-gx, gy)
+    az, alt = math.radians(315), math.radians(45)
+    shade = np.sin(alt) * np.cos(slope) + np.cos(alt) * np.sin(slope) * np.cos(az - aspect)
+    le0, ln1 = local_en(gt[3] + y0 * gt[5], gt[0] + x0 * gt[1], lat0, lon0)
+    le1, ln0 = local_en(gt[3] + y1 * gt[5], gt[0] + x1 * gt[1], lat0, lon0)
+    ax.imshow(shade, cmap="gray", extent=[le0, le1, ln0, ln1], origin="upper", alpha=0.55, zorder=0)
+    cs = ax.contour(np.linspace(le0, le1, z.shape[1]), np.linspace(ln1, ln0, z.shape[0]), z,
+                    levels=12, colors="saddlebrown", linewidths=0.4, alpha=0.6, zorder=1)
+    ax.clabel(cs, fontsize=6, fmt="%d m")
+
+
+def ellipse_xy(e, n, a, b, orient_deg, k=1.0, pts=48):
+    t = np.linspace(0, 2 * math.pi, pts)
+    u, v = k * a * np.cos(t), k * b * np.sin(t)
+    so, co = math.sin(math.radians(orient_deg)), math.cos(math.radians(orient_deg))
+    return e + u * so + v * co, n + u * co - v * so
+
+
+def plot_replay(args):
+    rows = read_csv(os.path.join(args.dir, "track.csv"))
+    t = (col(rows, "t_ns") - float(rows[0]["t_ns"])) * 1e-9
+    lat, lon = col(rows, "lat_deg"), col(rows, "lon_deg")
+    rlat, rlon = col(rows, "ref_lat_deg"), col(rows, "ref_lon_deg")
+    lat0, lon0 = float(np.nanmean(lat)), float(np.nanmean(lon))
+    e, n = local_en(lat, lon, lat0, lon0)
+    re_, rn = local_en(rlat, rlon, lat0, lon0)
+    a, b, o = col(rows, "semi_major_m"), col(rows, "semi_minor_m"), col(rows, "orientation_deg")
+    engines = [r["engine"] for r in rows]
+
+    fig, ax = plt.subplots(figsize=(9, 8))
+    pad = max(50.0, 0.1 * max(np.nanmax(e) - np.nanmin(e), np.nanmax(n) - np.nanmin(n)))
+    extent = (np.nanmin(e) - pad, np.nanmax(e) + pad, np.nanmin(n) - pad, np.nanmax(n) + pad)
+    if args.background:
+        hillshade_background(ax, args.background, lat0, lon0, extent)
+    if np.isfinite(re_).any():
+        ax.plot(re_, rn, "k-", lw=1.5, label="reference", zorder=3)
+    for eng, colr in (("dead-reckoning", "tab:orange"), ("terrain", "tab:blue"), ("route", "tab:green"),
+                      ("gnss", "tab:purple")):
+        m = np.array([x == eng for x in engines])
+        if m.any():
+            ax.plot(np.where(m, e, np.nan), np.where(m, n, np.nan), "-", color=colr, lw=1.2,
+                    label=f"estimate ({eng})", zorder=4)
+    step = max(1, len(rows) // 40)
+    for i in range(0, len(rows), step):
+        if np.isfinite(a[i]):
+            x, y = ellipse_xy(e[i], n[i], a[i], b[i], o[i])
+            ax.plot(x, y, "-", color="tab:red", lw=0.6, alpha=0.7, zorder=5)
+    ax.plot([], [], "-", color="tab:red", lw=0.6, label="1-sigma ellipse")
+    ax.set_xlim(extent[0], extent[1])
+    ax.set_ylim(extent[2], extent[3])
+    ax.set_aspect("equal")
+    ax.set_xlabel("east (m)")
+    ax.set_ylabel("north (m)")
+    ax.set_title(args.title or f"track: {os.path.basename(os.path.normpath(args.dir))}")
+    ax.legend(loc="best", fontsize=8)
+    fig.tight_layout()
+    out1 = os.path.join(args.dir, "track.png")
+    fig.savefig(out1, dpi=110)
+    plt.close(fig)
+    written = [out1]
+
+    err = np.hypot(col(rows, "err_e_m"), col(rows, "err_n_m"))
+    if np.isfinite(err).any():
+        sig = np.sqrt(a ** 2 + b ** 2)  # predicted DRMS
+        fig, ax = plt.subplots(figsize=(9, 4))
+        ax.plot(t, err, "b-", lw=1, label="horizontal error")
+        ax.plot(t, sig, "r--", lw=1, label="predicted 1-sigma (DRMS)")
+        ax.plot(t, 2 * sig, "r:", lw=1, label="predicted 2-sigma")
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("m")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        ax.set_title("error vs predicted uncertainty")
+        fig.tight_layout()
+        out2 = os.path.join(args.dir, "error.png")
+        fig.savefig(out2, dpi=110)
+        plt.close(fig)
+        written.append(out2)
+    for w in written:
+        print(f"plot: wrote {w}")
+
+
+def plot_gnss(args):
+    rows = read_csv(args.csv)
+    out = args.out or os.path.dirname(os.path.abspath(args.csv))
+    os.makedirs(out, exist_ok=True)
+    keys = rows[0].keys()
+    tcol = "t_s" if "t_s" in keys else ("t_ns" if "t_ns" in keys else None)
+    t = col(rows, tcol) if tcol else np.arange(len(rows), dtype=float)
+    if tcol == "t_ns":
+        t = (t - t[0]) * 1e-9
+    else:
+        t = t - t[0]
+    written = []
+    fig, ax = plt.subplots(figsize=(7, 7))
+    for pre, colr in (("spp", "tab:orange"), ("kf", "tab:blue")):
+        if f"{pre}_e_m" in keys:
+            ax.plot(col(rows, f"{pre}_e_m"), col(rows, f"{pre}_n_m"), ".", ms=3, color=colr, label=pre.upper())
+    ax.plot([0], [0], "k+", ms=14, label="truth")
+    ax.set_aspect("equal")
+    ax.grid(alpha=0.3)
+    ax.set_xlabel("east error (m)")
+    ax.set_ylabel("north error (m)")
+    ax.legend()
+    fig.tight_layout()
+    p = os.path.join(out, "gnss_track.png")
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    written.append(p)
+    fig, ax = plt.subplots(figsize=(9, 4))
+    for pre, colr in (("spp", "tab:orange"), ("kf", "tab:blue")):
+        if f"{pre}_e_m" in keys:
+            ax.plot(t, np.hypot(col(rows, f"{pre}_e_m"), col(rows, f"{pre}_n_m")), "-", color=colr, label=pre.upper())
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("horizontal error (m)")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    p = os.path.join(out, "gnss_error.png")
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    written.append(p)
+    sat_cols = [k for k in keys if k.startswith("sats_")]
+    if sat_cols:
+        fig, ax = plt.subplots(figsize=(9, 3.5))
+        for k in sat_cols:
+            ax.step(t, col(rows, k), where="post", label=k[5:])
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("satellites used")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        p = os.path.join(out, "gnss_sats.png")
+        fig.savefig(p, dpi=110)
+        plt.close(fig)
+        written.append(p)
+    for w in written:
+        print(f"plot: wrote {w}")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("replay", help="plots of a `pdnav replay` output directory")
+    r.add_argument("dir")
+    r.add_argument("--background", help="GDAL raster for a hillshade background")
+    r.add_argument("--title")
+    g = sub.add_parser("gnss", help="plots of a `pdnav gnss --out CSV` file")
+    g.add_argument("csv")
+    g.add_argument("--out")
+    args = ap.parse_args()
+    plot_replay(args) if args.cmd == "replay" else plot_gnss(args)
+
+
+if __name__ == "__main__":
+    main()
