@@ -4,7 +4,12 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <stdexcept>
+
+#include <unistd.h>
+
+#include <Eigen/LU>
 
 namespace pdnav::cli {
 
@@ -28,21 +33,30 @@ std::vector<double> parse_number_list(const std::string& text, const std::string
   return out;
 }
 
+ProgressBar::ProgressBar(std::ostream* out, std::string label)
+    : out_(out), label_(std::move(label)), tty_(out != nullptr && isatty(STDERR_FILENO) != 0) {}
+
 void ProgressBar::update(double fraction) {
   if (!out_) return;
-  const int pct = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 100.0);
+  int pct = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 100.0);
+  if (!tty_) pct -= pct % 10;
   if (pct == last_percent_) return;
   last_percent_ = pct;
-  *out_ << "\r" << label_ << ": " << std::setw(3) << pct << " %" << std::flush;
+  if (tty_)
+    *out_ << "\r" << label_ << ": " << std::setw(3) << pct << " %" << std::flush;
+  else
+    *out_ << label_ << ": " << pct << " %\n";
 }
 
 void ProgressBar::done() {
-  if (out_ && last_percent_ >= 0) *out_ << "\r" << label_ << ": 100 %\n";
+  if (!out_ || last_percent_ < 0) return;
+  if (tty_) *out_ << "\r" << label_ << ": 100 %\n";
+  else if (last_percent_ != 100) *out_ << label_ << ": 100 %\n";
 }
 
 nlohmann::json ErrorStats::to_json() const {
   return {{"epochs_with_reference", n}, {"drms_m", drms_m}, {"rms_e_m", rms_e_m}, {"rms_n_m", rms_n_m},
-          {"p50_horizontal_m", p50_h_m}, {"p95_horizontal_m", p95_h_m}, {"coverage_1sigma", coverage_1sigma}};
+          {"p50_horizontal_m", p50_h_m}, {"p95_horizontal_m", p95_h_m}, {"coverage_1sigma", coverage_1sigma}, {"coverage_68", coverage_68}};
 }
 
 void ReplayRecorder::observe_reference(const Sample& s) {
@@ -110,7 +124,8 @@ void ReplayRecorder::finish() {
     const Eigen::Vector2d err(ep.err_e_m, ep.err_n_m);
     const Eigen::Matrix2d cov = ep.est.cov_en_m2;
     // inside the 1-sigma ellipse: Mahalanobis distance^2 <= 1 (39.3 % nominal in 2D)
-    ep.inside_1sigma = cov.determinant() > 0 && err.dot(cov.inverse() * err) <= 1.0;
+    ep.mahalanobis2 = cov.determinant() > 0 ? err.dot(cov.inverse() * err) : std::numeric_limits<double>::infinity();
+    ep.inside_1sigma = ep.mahalanobis2 <= 1.0;
   }
 }
 
@@ -130,7 +145,8 @@ ErrorStats ReplayRecorder::error_stats() const {
   ErrorStats s;
   std::vector<double> h;
   double se = 0, sn = 0;
-  std::int64_t inside = 0;
+  std::int64_t inside = 0, inside68 = 0;
+  const double k68 = -2.0 * std::log(1.0 - 0.6827);  // 2.2958
   for (const Epoch& e : epochs_) {
     if (!e.has_ref) continue;
     ++s.n;
@@ -138,6 +154,7 @@ ErrorStats ReplayRecorder::error_stats() const {
     sn += e.err_n_m * e.err_n_m;
     h.push_back(std::hypot(e.err_e_m, e.err_n_m));
     inside += e.inside_1sigma ? 1 : 0;
+    inside68 += e.mahalanobis2 <= k68 ? 1 : 0;
   }
   if (s.n == 0) return s;
   const double n = static_cast<double>(s.n);
@@ -149,6 +166,7 @@ ErrorStats ReplayRecorder::error_stats() const {
   s.p50_h_m = pct(0.50);
   s.p95_h_m = pct(0.95);
   s.coverage_1sigma = static_cast<double>(inside) / n;
+  s.coverage_68 = static_cast<double>(inside68) / n;
   return s;
 }
 

@@ -18,16 +18,18 @@ namespace pdnav::cli {
 /// "1.5,2,3" -> {1.5, 2, 3}; throws std::invalid_argument naming the option on bad input.
 std::vector<double> parse_number_list(const std::string& text, const std::string& what);
 
-/// A one-line progress indicator on a terminal stream (nothing when out is null).
+/// Progress on stderr: a self-rewriting line on a terminal, a line every 10 % otherwise
+/// (CI logs), nothing when out is null.
 class ProgressBar {
  public:
-  ProgressBar(std::ostream* out, std::string label) : out_(out), label_(std::move(label)) {}
+  ProgressBar(std::ostream* out, std::string label);
   void update(double fraction);
   void done();
 
  private:
   std::ostream* out_;
   std::string label_;
+  bool tty_ = false;
   int last_percent_ = -1;
 };
 
@@ -38,7 +40,8 @@ struct ErrorStats {
   double rms_n_m = 0.0;
   double p50_h_m = 0.0;
   double p95_h_m = 0.0;
-  double coverage_1sigma = 0.0;  // fraction of epochs inside the 1-sigma ellipse
+  double coverage_1sigma = 0.0;  // inside the 1-sigma ellipse (Mahalanobis <= 1; 39.3 % if consistent)
+  double coverage_68 = 0.0;      // inside the 68.27 % ellipse (Mahalanobis^2 <= 2.2958; 68.3 % if consistent)
   nlohmann::json to_json() const;
 };
 
@@ -48,6 +51,7 @@ struct Epoch {
   bool has_ref = false;
   geo::Geodetic ref;
   double err_e_m = 0.0, err_n_m = 0.0;
+  double mahalanobis2 = 0.0;  // err' P^-1 err
   bool inside_1sigma = false;
 };
 

@@ -31,7 +31,8 @@ struct NavigatorConfig {
   std::string graph_path;                 // project walkway graph (dem-tools), empty = no route engine
   std::vector<std::string> nav_paths;     // RINEX navigation files for the GNSS engine
   int particles = 500;                    // terrain engine (paper: 500 on a phone)
-  std::string terrain_preset = "srtm";    // "paper" (fine DEM) or "srtm" (30-90 m DEM tuning)
+  std::string terrain_preset = "srtm-tuned";  // "paper" (lidar DEM), "srtm" (paper's 30 m tuning),
+                                              // "srtm-tuned" (docs/terrain.md; the eval default)
   /// Errors here are thrown from the constructor (std::runtime_error with file and reason).
 };
 

@@ -1,0 +1,63 @@
+package org.pdnav.app.nav
+
+/**
+ * The raw natives of libpdnav_jni (core-cpp/jni/bridge.cpp, registered in JNI_OnLoad).
+ * Only [NativeNavigator], [NativeRecorder] and [NativeLogReader] call these; they own the
+ * handles. A handle of 0 (closed or never opened) makes every call throw
+ * IllegalStateException; C++ exceptions arrive as IllegalArgumentException, IOException or
+ * RuntimeException. Array arguments are nullable on purpose: the bridge must reject null
+ * with IllegalArgumentException rather than crash, and the misuse tests check that.
+ */
+object NativeBridge {
+    /** System property naming the library file (host JVM tests); else loadLibrary("pdnav_jni"). */
+    const val LIBRARY_PROPERTY = "pdnav.jni.lib"
+
+    init {
+        val path = System.getProperty(LIBRARY_PROPERTY)
+        if (path.isNullOrEmpty()) System.loadLibrary("pdnav_jni") else System.load(path)
+        SampleLayout.check(layout())
+    }
+
+    /** Forces the library to load (and its layout to be checked). */
+    fun ensureLoaded() = Unit
+
+    @JvmStatic external fun layout(): IntArray
+    @JvmStatic external fun engineNames(): Array<String>
+    @JvmStatic external fun statusNames(): Array<String>
+
+    @JvmStatic external fun navCreate(
+        mode: String?, startLatDeg: Double, startLonDeg: Double, startSigmaM: Double,
+        userHeightM: Double, userFemale: Boolean, demPath: String?, graphPath: String?,
+        navPaths: Array<String>?, particles: Int, terrainPreset: String?, seed: Long,
+    ): Long
+
+    @JvmStatic external fun navFeed(
+        handle: Long, n: Int, kinds: IntArray?, tNs: LongArray?, ints: LongArray?,
+        doubles: DoubleArray?, strings: Array<String?>?, bytes: ByteArray?,
+    )
+
+    @JvmStatic external fun navSetStart(handle: Long, latDeg: Double, lonDeg: Double, sigmaM: Double, tNs: Long)
+    @JvmStatic external fun navEstimate(handle: Long): NavEstimate
+    @JvmStatic external fun navOutput(handle: Long, maxParticles: Int): NavOutput
+    @JvmStatic external fun navIgnored(handle: Long): Array<String>
+    @JvmStatic external fun navClose(handle: Long)
+
+    @JvmStatic external fun recOpen(path: String?, device: String?, flushIntervalNs: Long, fsync: Boolean): Long
+    @JvmStatic external fun recWrite(
+        handle: Long, n: Int, kinds: IntArray?, tNs: LongArray?, ints: LongArray?,
+        doubles: DoubleArray?, strings: Array<String?>?, bytes: ByteArray?,
+    )
+    @JvmStatic external fun recFlush(handle: Long)
+    @JvmStatic external fun recLines(handle: Long): Long
+    @JvmStatic external fun recClose(handle: Long)
+
+    @JvmStatic external fun readerOpen(path: String?): Long
+    @JvmStatic external fun readerRead(
+        handle: Long, max: Int, kinds: IntArray?, tNs: LongArray?, ints: LongArray?,
+        doubles: DoubleArray?, strings: Array<String?>?, bytes: ByteArray?,
+    ): Int
+    /** [lines read, samples returned, lines skipped]. */
+    @JvmStatic external fun readerStats(handle: Long): LongArray
+    @JvmStatic external fun readerProgress(handle: Long): Double
+    @JvmStatic external fun readerClose(handle: Long)
+}

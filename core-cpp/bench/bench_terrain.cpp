@@ -1,0 +1,80 @@
+// Terrain particle filter throughput: nanoseconds per particle per step (propagate + DEM
+// lookup + weight + resample when Neff < N/2) at 1k .. 1M particles, per resampling scheme.
+// Reported counters: ns_per_particle_step, bytes_per_particle. Run in a Release build:
+//   build/release/bench/bench_terrain --benchmark_counters_tabular=true
+#include <cmath>
+#include <memory>
+
+#include <benchmark/benchmark.h>
+
+#include "pdnav/geo/baro.h"
+#include "pdnav/terrain/terrain_engine.h"
+
+namespace {
+
+using namespace pdnav;
+using namespace pdnav::terrain;
+
+std::shared_ptr<const Dem> bench_dem() {
+  // 12 x 12 km of hills at 30 m (the size of the Andorra eval tile).
+  static const auto dem = [] {
+    DemInfo info;
+    info.origin_lat_deg = 42.5;
+    info.origin_lon_deg = 1.5;
+    info.cols = info.rows = 401;
+    info.cell_m = 30.0;
+    info.x0_m = info.y0_m = -6000.0;
+    info.vertical_datum = "EGM96";
+    std::vector<float> v(static_cast<std::size_t>(info.cols) * info.rows);
+    for (int j = 0; j < info.rows; ++j)
+      for (int i = 0; i < info.cols; ++i) {
+        const double e = info.x0_m + i * info.cell_m, n = info.y0_m + j * info.cell_m;
+        v[static_cast<std::size_t>(j) * info.cols + i] =
+            static_cast<float>(1500 + 120 * std::sin(e / 700) * std::cos(n / 900) + 60 * std::sin((e + 2 * n) / 330));
+      }
+    return std::make_shared<const Dem>(Dem::from_grid(info, std::move(v)));
+  }();
+  return dem;
+}
+
+void run(benchmark::State& state, Resampling scheme) {
+  TerrainOptions o = TerrainOptions::srtm_tuned();
+  o.particles = static_cast<int>(state.range(0));
+  o.resampling = scheme;
+  o.update_distance_m = 0.0;  // measurement update on every step: the worst case
+  TerrainEngine pf(o, bench_dem(), 1);
+  pf.initialize(bench_dem()->to_geodetic(0, 0), 5.0, 0);
+  TimeNs t = 0;
+  double e = 0, n = 0, heading = 0.3;
+  for (auto _ : state) {
+    t += 550 * kNsPerMs;
+    heading += 0.002;
+    e += 0.7 * std::sin(heading);
+    n += 0.7 * std::cos(heading);
+    PressureSample p;
+    p.t_ns = t - kNsPerMs;
+    p.pressure_pa = geo::baro_pressure_pa(bench_dem()->at_local(e, n).elevation_m, 101325.0, 0.0);
+    pf.feed(p);
+    PdrStep s;
+    s.t_ns = t;
+    s.length_m = 0.7;
+    s.heading_rad = heading;
+    pf.feed(s);
+  }
+  const double particle_steps = static_cast<double>(state.iterations()) * static_cast<double>(o.particles);
+  state.counters["ns_per_particle_step"] =
+      benchmark::Counter(particle_steps, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["bytes_per_particle"] = static_cast<double>(TerrainEngine::bytes_per_particle());
+  state.counters["resample_fraction"] =
+      static_cast<double>(pf.stats().resamples) / static_cast<double>(std::max<std::int64_t>(1, pf.stats().steps));
+}
+
+void BM_TerrainStep_Multinomial(benchmark::State& s) { run(s, Resampling::kMultinomial); }
+void BM_TerrainStep_Systematic(benchmark::State& s) { run(s, Resampling::kSystematic); }
+void BM_TerrainStep_Stratified(benchmark::State& s) { run(s, Resampling::kStratified); }
+
+BENCHMARK(BM_TerrainStep_Multinomial)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TerrainStep_Systematic)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TerrainStep_Stratified)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMicrosecond);
+
+}  // namespace

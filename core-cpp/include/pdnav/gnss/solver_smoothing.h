@@ -1,0 +1,52 @@
+// Carrier-smoothed code (Hatch filter; RTCA DO-229 100 s smoothing window): each pseudorange
+// is averaged with the previous smoothed value propagated by the carrier-phase (ADR) change,
+// or by the integrated pseudorange rate (Doppler smoothing) when ADR is missing, reset or
+// slipped. Code noise of a phone is white at the 1 s rate, so this cuts it by ~sqrt(window).
+#pragma once
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "pdnav/gnss/types.h"
+
+namespace pdnav::gnss {
+
+struct SmoothingOptions {
+  double window_s = 100.0;          // RTCA DO-229 (100 s); 0 disables smoothing
+  double max_jump_m = 60.0;         // |code - propagated| above this restarts the satellite (slip / code error)
+};
+
+/// One satellite's inputs at an epoch (NaN when missing).
+struct SmoothingInput {
+  SatId sat;
+  double pseudorange_m = 0.0;
+  double adr_m = 0.0;               // NaN unless valid and not reset / slipped
+  double pr_rate_mps = 0.0;
+};
+
+class CodeSmoother {
+ public:
+  explicit CodeSmoother(SmoothingOptions opt = {}) : opt_(opt) {}
+  /// Starts a new epoch `dt_s` after the previous one; `clock_jump_m` = c * change of
+  /// (FullBiasNanos + BiasNanos), which moves the code but not the carrier. A non-positive
+  /// dt_s (gap, clock discontinuity) restarts every satellite.
+  void begin_epoch(double dt_s, double clock_jump_m);
+  /// Smoothed pseudorange of one satellite at this epoch; `reason` is set when it restarted
+  /// for a reason worth counting ("code-carrier jump").
+  double smooth(const SmoothingInput& in, std::string* reason = nullptr);
+  void reset() { sats_.clear(); }
+
+ private:
+  struct Sat {
+    double pr_sm_m = 0.0, adr_m = 0.0, pr_rate_mps = 0.0;
+    double n = 0.0;
+    std::int64_t epoch = -1;
+  };
+  SmoothingOptions opt_;
+  std::map<SatId, Sat> sats_;
+  std::int64_t epoch_ = 0;
+  double dt_s_ = 0.0;
+  double clock_jump_m_ = 0.0;
+};
+
+}  // namespace pdnav::gnss

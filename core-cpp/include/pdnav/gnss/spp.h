@@ -1,0 +1,84 @@
+// Single-point positioning: weighted least squares in ECEF with one receiver clock per epoch
+// plus one inter-system bias per extra constellation (Walker, Remote Sens. 2019, Eq. 1 and
+// its multi-GNSS form), Sagnac correction, Klobuchar + Saastamoinen, elevation mask, DOP and
+// residual-based fault detection and exclusion (chi-square test, exclude worst, repeat).
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pdnav/geo/frames.h"
+#include "pdnav/geo/samples.h"
+#include "pdnav/gnss/atmosphere.h"
+#include "pdnav/gnss/ephemeris.h"
+#include "pdnav/gnss/types.h"
+
+namespace pdnav::gnss {
+
+/// Variance of a measurement from C/N0 (and elevation):
+///   sigma^2 = a / sin^2(el) + b * 10^(-C/N0 / 10)
+/// the SNR form of Walker 2019 Sec. 2.3 (sigma^2 = a + b 10^(-C/N0/10)) with the constant
+/// term mapped by elevation (RTKLIB-style elevation weighting) for code multipath.
+double cn0_elevation_variance(double a, double b, double cn0_dbhz, double el_rad);
+
+/// Upper quantile of the chi-square distribution (Wilson-Hilferty approximation, relative
+/// error < 3 % for dof >= 1 at P_fa 1e-3..0.05, erring high, i.e. slightly conservative).
+double chi_square_quantile(double p_false_alarm, int dof);
+
+struct SppOptions {
+  double elevation_mask_deg = 10.0;     // Walker 2019 Sec. 2.2 (10 deg mask)
+  double code_var_a_m2 = 4.0;           // a of cn0_elevation_variance for code [m^2] (2 m at zenith, strong signal)
+  double code_var_b_m2 = 160000.0;      // b [m^2 (Hz)]: 4 m at 40 dB-Hz, 22 m at 25 dB-Hz (phone code noise)
+  double fde_false_alarm = 1e-3;        // chi-square test probability (RAIM P_fa)
+  int max_fde_exclusions = 4;           // stop excluding after this many satellites
+  int max_iterations = 12;
+  double convergence_m = 1e-4;
+  double max_gdop = 30.0;               // worse geometry is rejected as singular
+  double min_rcond = 1e-10;             // normal-matrix reciprocal condition number guard
+  bool ionosphere = true;               // Klobuchar (IS-GPS-200 20.3.3.5.2.5), scaled by (f_L1/f)^2
+  bool troposphere = true;              // Saastamoinen + mapping function
+  bool drop_single_sat_systems = true;  // a lone satellite of a system only feeds its own ISB
+};
+
+/// One pseudorange with the satellite state at its transmit time.
+struct SppObservation {
+  SatId sat;
+  double pseudorange_m = 0.0;
+  double cn0_dbhz = 0.0;
+  double carrier_hz = 1575.42e6;
+  SatState state;  // at transmit time, from EphemerisStore::state
+};
+
+struct SppSolution {
+  bool ok = false;
+  std::string reason;                              // why not ok ("fewer than 4 satellites", ...)
+  geo::Ecef pos;
+  double clock_m = 0.0;                            // receiver clock of the reference system, c*dt
+  Constellation clock_system = Constellation::kGps;
+  std::map<Constellation, double> isb_m;           // inter-system bias vs the reference system
+  Eigen::Matrix3d pos_cov_ecef = Eigen::Matrix3d::Identity();  // a priori weights, m^2
+  double clock_var_m2 = 0.0;
+  double gdop = 0.0, pdop = 0.0, hdop = 0.0, vdop = 0.0;
+  std::vector<SatId> used;
+  std::vector<double> residuals_m;                 // post-fit, same order as used
+  std::vector<double> elevations_rad;              // same order as used
+  std::vector<SatId> excluded_fde;
+  std::map<std::string, std::int64_t> excluded;    // reason -> count (mask, single-sat system, FDE)
+  int iterations = 0;
+  double chi2 = 0.0;                               // weighted sum of squared residuals
+  std::map<Constellation, int> used_by_sys() const;
+};
+
+/// Solves one epoch. `initial` is a position guess (Earth centre when unknown); the elevation
+/// mask and atmosphere are applied once the iterate is near the Earth's surface. `gps_tow_s`
+/// is the reception time of week for Klobuchar; `klob` may be null (no ionosphere model).
+SppSolution solve_spp(const std::vector<SppObservation>& obs, const geo::Ecef& initial,
+                      double gps_tow_s, const KlobucharParams* klob, const SppOptions& opt);
+
+/// Sagnac (Earth rotation during signal travel) correction: the satellite position of the
+/// transmit instant expressed in the ECEF frame of the receive instant.
+Eigen::Vector3d rotate_for_travel_time(const Eigen::Vector3d& sat_ecef_m, double travel_s);
+
+}  // namespace pdnav::gnss

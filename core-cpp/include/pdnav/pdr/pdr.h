@@ -1,0 +1,122 @@
+// The PDR engine face: raw inertial samples in, steps (time, length, true-north heading,
+// sigmas) and turns out. Deterministic (no random component, so no seed).
+#pragma once
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <vector>
+
+#include "pdnav/geo/events.h"
+#include "pdnav/geo/frames.h"
+#include "pdnav/geo/samples.h"
+#include "pdnav/pdr/heading.h"
+#include "pdnav/pdr/step_detector.h"
+#include "pdnav/pdr/step_length.h"
+
+namespace pdnav::pdr {
+
+/// Which step events drive the output.
+enum class StepSource {
+  kAccelerometer,  // APT level-crossing detector (default)
+  kAndroid,        // Android TYPE_STEP_DETECTOR events (as the terrain paper does)
+  kAuto,           // Android events while they arrive (within android_timeout_s), else accelerometer
+};
+
+struct PdrOptions {
+  StepDetectorOptions detector;  // APT Sec. V-A (+ gates)
+  StepLengthModel length;        // APT Sec. V-A: l = c1 * height
+  HeadingOptions heading;        // rotation vector + WMM, or APT Sec. V-B gyro re-orientation
+  StepSource source = StepSource::kAccelerometer;
+  double android_timeout_s = 3.0;
+  /// Consistency check: the two step sources agree when their counts differ by at most this
+  /// fraction over the window below.
+  double consistency_tolerance = 0.10;
+  double consistency_window_s = 30.0;
+};
+
+/// Sample counters by sensor and reason (skipped or reset).
+struct PdrCounters {
+  SampleCounters accel;
+  SampleCounters gyro;
+  SampleCounters mag;
+  SampleCounters rotation_vector;
+  SampleCounters step_detector;
+  std::int64_t steps_discarded_by_bout_gate = 0;
+  std::int64_t total_skipped() const {
+    return accel.skipped() + gyro.skipped() + mag.skipped() + rotation_vector.skipped() + step_detector.skipped();
+  }
+};
+
+/// Accelerometer detector vs Android step-detector events over the last consistency window.
+struct StepConsistency {
+  std::int64_t accel_steps = 0;    // accelerometer steps in the window
+  std::int64_t android_steps = 0;  // Android events in the window
+  double relative_difference = 0.0;  // |a - b| / max(a, b), 0 when both are 0
+  bool consistent = true;          // relative_difference <= tolerance (or too few steps to tell)
+};
+
+class Pdr {
+ public:
+  explicit Pdr(const PdrOptions& options = {});
+
+  void feed(const AccelSample& s);
+  void feed(const GyroSample& s);
+  void feed(const MagSample& s);
+  void feed(const RotationVectorSample& s);
+  void feed(const StepDetectorSample& s);
+  /// Position and UTC time (Unix ms) for the WMM declination; may be called again at any time.
+  void set_location(const geo::Geodetic& where, std::int64_t utc_ms);
+
+  /// Steps since the last call (time, length, TRUE-north heading, sigmas).
+  std::vector<PdrStep> take_steps();
+  /// Turns since the last call (APT Sec. V-B, positive = left).
+  std::vector<PdrTurn> take_turns();
+  /// Steps emitted so far (from the selected source).
+  std::int64_t step_count() const { return step_count_; }
+  /// Current true heading (clockwise from north, [0, 2pi)) and its 1-sigma. Before any rotation
+  /// vector or compass reading it is the gyro-propagated options.heading.initial_heading_rad.
+  double heading_rad() const;
+  double heading_sigma_rad() const;
+  double declination_rad() const { return declination_rad_; }
+  PdrCounters counters() const;
+  StepConsistency consistency() const;
+  const PdrOptions& options() const { return opt_; }
+
+ private:
+  void emit_step(TimeNs t_ns, double swing_mps2);
+  bool android_active(TimeNs t_ns) const;
+  void trim_consistency(TimeNs t_ns);
+
+  PdrOptions opt_;
+  StepDetector detector_;
+  BoutGate<StepCandidate> gate_;
+  GyroTurnTracker tracker_;
+  std::int64_t gaps_seen_ = 0;
+  PdrCounters counters_;
+  // heading state: magnetic heading reference + yaw at that moment, propagated by the gyro
+  bool have_heading_ = false;
+  double ref_heading_mag_rad_ = 0.0;  // magnetic heading at ref_yaw
+  double ref_yaw_rad_ = 0.0;
+  double ref_sigma_rad_ = 0.0;
+  TimeNs ref_t_ns_ = 0;
+  bool ref_from_rv_ = false;
+  TimeNs last_rv_ns_ = 0;
+  bool have_rv_ = false;
+  std::optional<double> last_rv_heading_;
+  double last_rv_sigma_ = 0.0;
+  TimeNs last_rv_check_ns_ = 0;
+  bool have_mag_last_ = false;
+  TimeNs mag_last_ns_ = 0;
+  bool have_sd_last_ = false;
+  TimeNs sd_last_ns_ = 0;
+  double declination_rad_ = 0.0;
+  TimeNs latest_ns_ = 0;
+  // outputs
+  std::vector<PdrStep> steps_;
+  std::int64_t step_count_ = 0;
+  std::deque<TimeNs> accel_step_times_, android_step_times_;
+  TimeNs last_android_ns_ = 0;
+  bool have_android_ = false;
+};
+
+}  // namespace pdnav::pdr

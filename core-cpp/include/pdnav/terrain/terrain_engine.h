@@ -1,0 +1,120 @@
+// Terrain engine: the SIR particle filter of Broyles, Kauffman, Raquet, Smagowski,
+// "Non-GNSS Smartphone Pedestrian Navigation Using Barometric Elevation and Digital Map-Matching",
+// Sensors 2018, 18, 2232 (Eq. 1-10), with residual monitoring and a structure-of-arrays layout.
+// State per particle: [east, north, heading bias, baro bias] in the DEM tile's ENU frame.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pdnav/geo/baro.h"
+#include "pdnav/geo/estimate.h"
+#include "pdnav/geo/events.h"
+#include "pdnav/geo/samples.h"
+#include "pdnav/terrain/dem.h"
+
+namespace pdnav::terrain {
+
+enum class Resampling {
+  kMultinomial,  // paper default (Eq. 10), O(N) through sorted uniforms from exponential spacings
+  kSystematic,   // one uniform offset, N evenly spaced pointers (Kitagawa 1996)
+  kStratified,   // one uniform per stratum
+};
+const char* to_string(Resampling r);
+Resampling resampling_from_string(const std::string& s);  // throws std::invalid_argument
+
+struct TerrainOptions {
+  int particles = 500;                          // Broyles 2018 Sec. 4: 500 particles on the phone
+  double step_length_sigma_m = 0.15;            // sigma_l, Eq. 1-2: dl ~ U(-sigma_l, sigma_l)
+  double heading_bias_sigma_rad = 15.0 * kDegToRad;  // sigma_theta, Eq. 3 (FOGM heading bias)
+  double heading_bias_tau_s = 60.0;             // tau_theta, Eq. 3
+  double baro_bias_sigma_m = 5.0;               // sigma_b, Eq. 4 (FOGM baro bias)
+  double baro_bias_tau_s = 3600.0;              // tau_b, Eq. 4
+  double measurement_var_m2 = 16.0;             // R, Eq. 5-7 (lidar-class DEM)
+  double initial_sigma_m = 5.0;                 // initial position 1-sigma per axis, Sec. 3
+  double resample_threshold = 0.5;              // resample when Neff < 0.5 N, Eq. 10
+  Resampling resampling = Resampling::kMultinomial;  // paper default
+  /// Beyond the paper: update only after this horizontal distance walked since the last
+  /// update (baro averaged meanwhile); 0 = every step (paper). Limits over-confidence from
+  /// DEM errors that are correlated over a cell.
+  double update_distance_m = 0.0;
+  /// Beyond the paper: a per-particle constant step-length scale error ~ N(0, sigma), a fifth
+  /// state; 0 = the paper's four-state filter.
+  double step_scale_sigma = 0.0;
+  /// Beyond the paper: roughening after resampling (Gordon et al. 1993), K; 0 = off.
+  double roughening_k = 0.0;
+  // --- residual monitoring (the paper mentions it without detail; docs/terrain.md) ---
+  bool residual_monitor = true;
+  int monitor_window = 15;                      // updates in the normalised-innovation average
+  double monitor_nis_threshold = 2.0;           // mean NIS above this = divergence / false lock
+  double monitor_outlier_sigmas = 6.0;          // every particle beyond this = immediate alarm
+  double respread_sigma_m = 60.0;               // position noise added on recovery (per axis)
+  double recovery_noise_gain = 2.0;             // process noise multiplier while recovering
+  double recovery_duration_s = 60.0;
+  /// Void / off-map particles: likelihood of a residual of this many sigmas (no information,
+  /// a mild penalty), so voids neither kill nor attract particles.
+  double no_info_sigmas = 2.0;
+
+  /// Paper defaults (a 1-3 m lidar DEM).
+  static TerrainOptions paper() { return {}; }
+  /// The paper's 30 m / SRTM tuning: sigma_b 20 m, tau_b 1200 s, R 160 m^2, update every step.
+  static TerrainOptions srtm_preset();
+  /// Beyond the paper, for 30-90 m DEMs (SRTM), tuned on simulated walks (docs/terrain.md):
+  /// sigma_b 6 m, tau_b 600 s, R 30 m^2, an update every 10 m walked, a step-scale state
+  /// (sigma 3 %) and roughening K = 0.2. The eval-terrain default.
+  static TerrainOptions srtm_tuned();
+  /// "paper", "srtm" or "srtm-tuned"; throws std::invalid_argument.
+  static TerrainOptions preset(const std::string& name);
+};
+
+/// Counters for diagnostics and tests.
+struct TerrainStats {
+  std::int64_t steps = 0;
+  std::int64_t updates = 0;              // measurement updates applied
+  std::int64_t skipped_updates = 0;      // no valid DEM under any particle / no baro yet
+  std::int64_t resamples = 0;
+  std::int64_t weight_underflows = 0;    // all weights vanished: reset to uniform
+  std::int64_t recoveries = 0;           // residual monitor re-spreads
+  double last_nis = 0.0;                 // last normalised innovation squared
+  double mean_nis = 0.0;                 // window mean of NIS
+  double neff_fraction = 1.0;            // last Neff / N
+  double off_dem_fraction = 0.0;         // weight on void / off-map cells at the last update
+};
+
+class TerrainEngine {
+ public:
+  TerrainEngine(const TerrainOptions& options, std::shared_ptr<const Dem> dem, std::uint64_t seed);
+  ~TerrainEngine();
+  TerrainEngine(TerrainEngine&&) noexcept;
+  TerrainEngine& operator=(TerrainEngine&&) noexcept;
+
+  /// Spread particles around the declared start (sigma per axis) and anchor the barometer
+  /// at the DEM elevation there: the next pressure sample becomes the reference pressure.
+  void initialize(const geo::Geodetic& start, double sigma_m, TimeNs t_ns);
+  /// Propagation (Eq. 1-4), then a measurement update (Eq. 5-7) when baro is available,
+  /// then resampling when Neff < threshold (Eq. 10).
+  void feed(const PdrStep& step);
+  /// Barometer: converted to altitude (geo::baro_altitude_m) and averaged until the next update.
+  void feed(const PressureSample& p);
+
+  /// Weighted mean and covariance (Eq. 8-9), status and reason.
+  Estimate estimate() const;
+  /// Up to max particles (evenly thinned), east/north in the DEM frame.
+  std::vector<Eigen::Vector2d> particles_en(std::size_t max) const;
+  /// Weighted means of the bias states (heading bias rad, baro bias m).
+  Eigen::Vector2d bias_estimate() const;
+  const TerrainStats& stats() const;
+  const TerrainOptions& options() const;
+  const Dem& dem() const;
+  /// Heap bytes held per particle (state, weights, resampling buffers).
+  static std::size_t bytes_per_particle();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace pdnav::terrain

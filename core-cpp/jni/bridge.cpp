@@ -1,0 +1,379 @@
+// The registered natives of org.pdnav.app.nav.NativeBridge (JNI_OnLoad + RegisterNatives).
+// Each native converts its arguments, locks the handle's mutex, forwards to the core
+// (fusion::Navigator, io::LogWriter, io::LogReader) and converts the result back.
+#include <jni.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "jni_support.h"
+#include "pdnav/fusion/navigator.h"
+#include "pdnav/io/log_reader.h"
+#include "pdnav/io/log_writer.h"
+#include "sample_codec.h"
+
+namespace pdnav::jni {
+namespace {
+
+using NavHandle = Handle<fusion::Navigator>;
+using RecHandle = Handle<io::LogWriter>;
+using ReaderHandle = Handle<io::LogReader>;
+
+constexpr const char* kBridgeClass = "org/pdnav/app/nav/NativeBridge";
+constexpr const char* kEstimateClass = "org/pdnav/app/nav/NavEstimate";
+constexpr const char* kOutputClass = "org/pdnav/app/nav/NavOutput";
+constexpr const char* kEstimateCtor = "(JIILjava/lang/String;DDDDDDDDD)V";
+constexpr const char* kOutputCtor =
+    "(Lorg/pdnav/app/nav/NavEstimate;[Lorg/pdnav/app/nav/NavEstimate;J[D)V";
+
+JavaBatchArrays arrays(jintArray k, jlongArray t, jlongArray i, jdoubleArray d, jobjectArray s,
+                       jbyteArray b) {
+  return JavaBatchArrays{k, t, i, d, s, b};
+}
+
+jclass find_class(JNIEnv* env, const char* name) {
+  jclass c = env->FindClass(name);
+  if (c == nullptr) throw JavaError(kRuntime, std::string("class not found: ") + name);
+  return c;
+}
+
+jobject new_estimate(JNIEnv* env, const Estimate& e) {
+  jclass c = find_class(env, kEstimateClass);
+  jmethodID ctor = env->GetMethodID(c, "<init>", kEstimateCtor);
+  if (ctor == nullptr) throw JavaError(kRuntime, "NavEstimate constructor not found");
+  jstring reason = env->NewStringUTF(e.reason.c_str());
+  const bool has_position = e.status != EstimateStatus::kNotInitialized;
+  const double nan = std::nan("");
+  jobject o = env->NewObject(c, ctor, static_cast<jlong>(e.t_ns), static_cast<jint>(e.engine),
+                             static_cast<jint>(e.status), reason,
+                             has_position ? e.position.lat_deg() : nan,
+                             has_position ? e.position.lon_deg() : nan,
+                             has_position ? e.position.h_m : nan, e.en_m.x(), e.en_m.y(),
+                             e.cov_en_m2(0, 0), e.cov_en_m2(0, 1), e.cov_en_m2(1, 1),
+                             e.vertical_sigma_m);
+  env->DeleteLocalRef(reason);
+  env->DeleteLocalRef(c);
+  if (o == nullptr) throw JavaError(kRuntime, "NavEstimate allocation failed");
+  return o;
+}
+
+// ---- static information -------------------------------------------------------------
+
+jintArray layout(JNIEnv* env, jclass) {
+  return guarded<jintArray>(env, nullptr, [&] {
+    const jint v[] = {kLayoutVersion, static_cast<jint>(kInts), static_cast<jint>(kDoubles),
+                      static_cast<jint>(kStrings), static_cast<jint>(kBytes), kKinds};
+    jintArray a = env->NewIntArray(6);
+    env->SetIntArrayRegion(a, 0, 6, v);
+    return a;
+  });
+}
+
+jobjectArray names(JNIEnv* env, const std::vector<std::string>& v) {
+  jclass sc = find_class(env, "java/lang/String");
+  jobjectArray a = env->NewObjectArray(static_cast<jsize>(v.size()), sc, nullptr);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    jstring s = env->NewStringUTF(v[i].c_str());
+    env->SetObjectArrayElement(a, static_cast<jsize>(i), s);
+    env->DeleteLocalRef(s);
+  }
+  env->DeleteLocalRef(sc);
+  return a;
+}
+
+jobjectArray engine_names(JNIEnv* env, jclass) {
+  return guarded<jobjectArray>(env, nullptr, [&] {
+    std::vector<std::string> v;
+    for (auto k : {EngineKind::kNone, EngineKind::kDeadReckoning, EngineKind::kTerrain,
+                   EngineKind::kRoute, EngineKind::kGnss}) {
+      v.emplace_back(to_string(k));
+    }
+    return names(env, v);
+  });
+}
+
+jobjectArray status_names(JNIEnv* env, jclass) {
+  return guarded<jobjectArray>(env, nullptr, [&] {
+    std::vector<std::string> v;
+    for (auto s : {EstimateStatus::kNotInitialized, EstimateStatus::kOk, EstimateStatus::kDegraded,
+                   EstimateStatus::kAmbiguous, EstimateStatus::kLost}) {
+      v.emplace_back(to_string(s));
+    }
+    return names(env, v);
+  });
+}
+
+// ---- navigator ------------------------------------------------------------------------
+
+jlong nav_create(JNIEnv* env, jclass, jstring mode, jdouble lat, jdouble lon, jdouble sigma,
+                 jdouble height, jboolean female, jstring dem, jstring graph, jobjectArray navs,
+                 jint particles, jstring preset, jlong seed) {
+  return guarded<jlong>(env, 0, [&] {
+    fusion::NavigatorConfig c;
+    c.mode = fusion::engine_mode_from_string(to_string(env, mode, "mode"));
+    c.start_lat_deg = lat;
+    c.start_lon_deg = lon;
+    c.start_sigma_m = sigma;
+    c.user_height_m = height;
+    c.user_female = female == JNI_TRUE;
+    c.dem_path = to_string(env, dem, "demPath");
+    c.graph_path = to_string(env, graph, "graphPath");
+    c.nav_paths = to_strings(env, navs, "navPaths");
+    if (particles <= 0) {
+      throw JavaError(kIllegalArgument, "particles must be > 0, got " + std::to_string(particles));
+    }
+    c.particles = particles;
+    c.terrain_preset = to_string(env, preset, "terrainPreset");
+    auto* h = new NavHandle(c, static_cast<std::uint64_t>(seed));
+    return to_handle(h);
+  });
+}
+
+void nav_feed(JNIEnv* env, jclass, jlong handle, jint n, jintArray k, jlongArray t, jlongArray i,
+              jdoubleArray d, jobjectArray s, jbyteArray b) {
+  guarded_void(env, [&] {
+    auto& h = from_handle<fusion::Navigator>(handle, "NativeNavigator");
+    const CopiedBatch batch(env, n, arrays(k, t, i, d, s, b));
+    std::vector<Sample> samples;
+    samples.reserve(batch.view().n);
+    for (std::size_t r = 0; r < batch.view().n; ++r) samples.push_back(decode_row(batch.view(), r));
+    const std::lock_guard<std::mutex> lock(h.mutex);
+    for (const auto& x : samples) h.object.feed(x);
+  });
+}
+
+void nav_set_start(JNIEnv* env, jclass, jlong handle, jdouble lat, jdouble lon, jdouble sigma,
+                   jlong t_ns) {
+  guarded_void(env, [&] {
+    auto& h = from_handle<fusion::Navigator>(handle, "NativeNavigator");
+    if (!std::isfinite(lat) || !std::isfinite(lon) || !(sigma > 0.0) || std::fabs(lat) > 90.0 ||
+        std::fabs(lon) > 180.0) {
+      throw JavaError(kIllegalArgument, "start position needs |lat| <= 90, |lon| <= 180, sigma > 0");
+    }
+    const std::lock_guard<std::mutex> lock(h.mutex);
+    h.object.set_start(lat, lon, sigma, t_ns);
+  });
+}
+
+jobject nav_estimate(JNIEnv* env, jclass, jlong handle) {
+  return guarded<jobject>(env, nullptr, [&] {
+    auto& h = from_handle<fusion::Navigator>(handle, "NativeNavigator");
+    Estimate e;
+    {
+      const std::lock_guard<std::mutex> lock(h.mutex);
+      e = h.object.estimate();
+    }
+    return new_estimate(env, e);
+  });
+}
+
+jobject nav_output(JNIEnv* env, jclass, jlong handle, jint max_particles) {
+  return guarded<jobject>(env, nullptr, [&] {
+    auto& h = from_handle<fusion::Navigator>(handle, "NativeNavigator");
+    if (max_particles < 0) throw JavaError(kIllegalArgument, "maxParticles must be >= 0");
+    fusion::NavigatorOutput out;
+    {
+      const std::lock_guard<std::mutex> lock(h.mutex);
+      out = h.object.output(static_cast<std::size_t>(max_particles));
+    }
+    jobject best = new_estimate(env, out.estimate);
+    jclass ec = find_class(env, kEstimateClass);
+    jobjectArray engines = env->NewObjectArray(static_cast<jsize>(out.engines.size()), ec, nullptr);
+    for (std::size_t i = 0; i < out.engines.size(); ++i) {
+      jobject e = new_estimate(env, out.engines[i]);
+      env->SetObjectArrayElement(engines, static_cast<jsize>(i), e);
+      env->DeleteLocalRef(e);
+    }
+    std::vector<double> en;
+    en.reserve(out.particles_en_m.size() * 2);
+    for (const auto& p : out.particles_en_m) {
+      en.push_back(p.x());
+      en.push_back(p.y());
+    }
+    jdoubleArray particles = env->NewDoubleArray(static_cast<jsize>(en.size()));
+    env->SetDoubleArrayRegion(particles, 0, static_cast<jsize>(en.size()), en.data());
+    jclass oc = find_class(env, kOutputClass);
+    jmethodID ctor = env->GetMethodID(oc, "<init>", kOutputCtor);
+    if (ctor == nullptr) throw JavaError(kRuntime, "NavOutput constructor not found");
+    jobject o = env->NewObject(oc, ctor, best, engines, static_cast<jlong>(out.steps), particles);
+    env->DeleteLocalRef(ec);
+    env->DeleteLocalRef(oc);
+    return o;
+  });
+}
+
+jobjectArray nav_ignored(JNIEnv* env, jclass, jlong handle) {
+  return guarded<jobjectArray>(env, nullptr, [&] {
+    auto& h = from_handle<fusion::Navigator>(handle, "NativeNavigator");
+    std::vector<std::pair<std::string, std::int64_t>> ign;
+    {
+      const std::lock_guard<std::mutex> lock(h.mutex);
+      ign = h.object.ignored();
+    }
+    std::vector<std::string> flat;  // reason, count, reason, count, ...
+    for (const auto& [reason, count] : ign) {
+      flat.push_back(reason);
+      flat.push_back(std::to_string(count));
+    }
+    return names(env, flat);
+  });
+}
+
+void nav_close(JNIEnv* env, jclass, jlong handle) {
+  guarded_void(env, [&] {
+    auto* h = &from_handle<fusion::Navigator>(handle, "NativeNavigator");
+    { const std::lock_guard<std::mutex> lock(h->mutex); }  // wait for a call in flight
+    delete h;
+  });
+}
+
+// ---- recorder (io::LogWriter) ---------------------------------------------------------
+
+jlong rec_open(JNIEnv* env, jclass, jstring path, jstring device, jlong flush_ns, jboolean fsync) {
+  return guarded<jlong>(env, 0, [&] {
+    io::LogWriterOptions o;
+    if (flush_ns <= 0) throw JavaError(kIllegalArgument, "flush interval must be > 0 ns");
+    o.flush_interval_ns = flush_ns;
+    o.fsync_on_flush = fsync == JNI_TRUE;
+    o.device = to_string(env, device, "device");
+    return to_handle(new RecHandle(to_string(env, path, "path"), o));
+  });
+}
+
+void rec_write(JNIEnv* env, jclass, jlong handle, jint n, jintArray k, jlongArray t, jlongArray i,
+               jdoubleArray d, jobjectArray s, jbyteArray b) {
+  guarded_void(env, [&] {
+    auto& h = from_handle<io::LogWriter>(handle, "NativeRecorder");
+    const CopiedBatch batch(env, n, arrays(k, t, i, d, s, b));
+    std::vector<Sample> samples;
+    samples.reserve(batch.view().n);
+    for (std::size_t r = 0; r < batch.view().n; ++r) samples.push_back(decode_row(batch.view(), r));
+    const std::lock_guard<std::mutex> lock(h.mutex);
+    for (const auto& x : samples) h.object.write(x);
+  });
+}
+
+void rec_flush(JNIEnv* env, jclass, jlong handle) {
+  guarded_void(env, [&] {
+    auto& h = from_handle<io::LogWriter>(handle, "NativeRecorder");
+    const std::lock_guard<std::mutex> lock(h.mutex);
+    h.object.flush();
+  });
+}
+
+jlong rec_lines(JNIEnv* env, jclass, jlong handle) {
+  return guarded<jlong>(env, 0, [&] {
+    auto& h = from_handle<io::LogWriter>(handle, "NativeRecorder");
+    const std::lock_guard<std::mutex> lock(h.mutex);
+    return static_cast<jlong>(h.object.lines_written());
+  });
+}
+
+void rec_close(JNIEnv* env, jclass, jlong handle) {
+  guarded_void(env, [&] {
+    auto* h = &from_handle<io::LogWriter>(handle, "NativeRecorder");
+    {
+      const std::lock_guard<std::mutex> lock(h->mutex);
+      h->object.close();
+    }
+    delete h;
+  });
+}
+
+// ---- log reader (io::LogReader) -------------------------------------------------------
+
+jlong reader_open(JNIEnv* env, jclass, jstring path) {
+  return guarded<jlong>(env, 0, [&] {
+    return to_handle(new ReaderHandle(to_string(env, path, "path")));
+  });
+}
+
+jint reader_read(JNIEnv* env, jclass, jlong handle, jint max, jintArray k, jlongArray t,
+                 jlongArray i, jdoubleArray d, jobjectArray s, jbyteArray b) {
+  return guarded<jint>(env, 0, [&] {
+    auto& h = from_handle<io::LogReader>(handle, "NativeLogReader");
+    if (max <= 0) throw JavaError(kIllegalArgument, "max must be > 0");
+    const JavaBatchArrays a = arrays(k, t, i, d, s, b);
+    check_batch_arrays(env, static_cast<std::size_t>(max), a);
+    OutBatch out(static_cast<std::size_t>(max));
+    std::size_t n = 0;
+    {
+      const std::lock_guard<std::mutex> lock(h.mutex);
+      Sample sample;
+      while (n < static_cast<std::size_t>(max) && h.object.next(sample)) {
+        encode_row(sample, out.rows(), n);
+        ++n;
+      }
+    }
+    out.copy_to(env, n, a);
+    return static_cast<jint>(n);
+  });
+}
+
+jlongArray reader_stats(JNIEnv* env, jclass, jlong handle) {
+  return guarded<jlongArray>(env, nullptr, [&] {
+    auto& h = from_handle<io::LogReader>(handle, "NativeLogReader");
+    const std::lock_guard<std::mutex> lock(h.mutex);
+    const auto& st = h.object.stats();
+    const jlong v[] = {st.lines, st.samples, st.skipped_total()};
+    jlongArray a = env->NewLongArray(3);
+    env->SetLongArrayRegion(a, 0, 3, v);
+    return a;
+  });
+}
+
+jdouble reader_progress(JNIEnv* env, jclass, jlong handle) {
+  return guarded<jdouble>(env, 0.0, [&] {
+    auto& h = from_handle<io::LogReader>(handle, "NativeLogReader");
+    const std::lock_guard<std::mutex> lock(h.mutex);
+    return h.object.progress();
+  });
+}
+
+void reader_close(JNIEnv* env, jclass, jlong handle) {
+  guarded_void(env, [&] {
+    auto* h = &from_handle<io::LogReader>(handle, "NativeLogReader");
+    { const std::lock_guard<std::mutex> lock(h->mutex); }
+    delete h;
+  });
+}
+
+#define PDNAV_BATCH_SIG "I[I[J[J[D[Ljava/lang/String;[B"
+
+const JNINativeMethod kMethods[] = {
+    {const_cast<char*>("layout"), const_cast<char*>("()[I"), reinterpret_cast<void*>(&layout)},
+    {const_cast<char*>("engineNames"), const_cast<char*>("()[Ljava/lang/String;"), reinterpret_cast<void*>(&engine_names)},
+    {const_cast<char*>("statusNames"), const_cast<char*>("()[Ljava/lang/String;"), reinterpret_cast<void*>(&status_names)},
+    {const_cast<char*>("navCreate"), const_cast<char*>("(Ljava/lang/String;DDDDZLjava/lang/String;Ljava/lang/String;[Ljava/lang/String;ILjava/lang/String;J)J"), reinterpret_cast<void*>(&nav_create)},
+    {const_cast<char*>("navFeed"), const_cast<char*>("(J" PDNAV_BATCH_SIG ")V"), reinterpret_cast<void*>(&nav_feed)},
+    {const_cast<char*>("navSetStart"), const_cast<char*>("(JDDDJ)V"), reinterpret_cast<void*>(&nav_set_start)},
+    {const_cast<char*>("navEstimate"), const_cast<char*>("(J)Lorg/pdnav/app/nav/NavEstimate;"), reinterpret_cast<void*>(&nav_estimate)},
+    {const_cast<char*>("navOutput"), const_cast<char*>("(JI)Lorg/pdnav/app/nav/NavOutput;"), reinterpret_cast<void*>(&nav_output)},
+    {const_cast<char*>("navIgnored"), const_cast<char*>("(J)[Ljava/lang/String;"), reinterpret_cast<void*>(&nav_ignored)},
+    {const_cast<char*>("navClose"), const_cast<char*>("(J)V"), reinterpret_cast<void*>(&nav_close)},
+    {const_cast<char*>("recOpen"), const_cast<char*>("(Ljava/lang/String;Ljava/lang/String;JZ)J"), reinterpret_cast<void*>(&rec_open)},
+    {const_cast<char*>("recWrite"), const_cast<char*>("(J" PDNAV_BATCH_SIG ")V"), reinterpret_cast<void*>(&rec_write)},
+    {const_cast<char*>("recFlush"), const_cast<char*>("(J)V"), reinterpret_cast<void*>(&rec_flush)},
+    {const_cast<char*>("recLines"), const_cast<char*>("(J)J"), reinterpret_cast<void*>(&rec_lines)},
+    {const_cast<char*>("recClose"), const_cast<char*>("(J)V"), reinterpret_cast<void*>(&rec_close)},
+    {const_cast<char*>("readerOpen"), const_cast<char*>("(Ljava/lang/String;)J"), reinterpret_cast<void*>(&reader_open)},
+    {const_cast<char*>("readerRead"), const_cast<char*>("(J" PDNAV_BATCH_SIG ")I"), reinterpret_cast<void*>(&reader_read)},
+    {const_cast<char*>("readerStats"), const_cast<char*>("(J)[J"), reinterpret_cast<void*>(&reader_stats)},
+    {const_cast<char*>("readerProgress"), const_cast<char*>("(J)D"), reinterpret_cast<void*>(&reader_progress)},
+    {const_cast<char*>("readerClose"), const_cast<char*>("(J)V"), reinterpret_cast<void*>(&reader_close)},
+};
+
+}  // namespace
+}  // namespace pdnav::jni
+
+extern "C" JNIEXPORT jint JNI_OnLoad(JavaVM* vm, void*) {
+  JNIEnv* env = nullptr;
+  if (vm->GetEnv(reinterpret_cast<void**>(&env), JNI_VERSION_1_6) != JNI_OK) return JNI_ERR;
+  jclass c = env->FindClass(pdnav::jni::kBridgeClass);
+  if (c == nullptr) return JNI_ERR;
+  const auto n = static_cast<jint>(sizeof(pdnav::jni::kMethods) / sizeof(pdnav::jni::kMethods[0]));
+  if (env->RegisterNatives(c, pdnav::jni::kMethods, n) != JNI_OK) return JNI_ERR;
+  env->DeleteLocalRef(c);
+  return JNI_VERSION_1_6;
+}

@@ -1,0 +1,122 @@
+// JNI plumbing of the bridge: exception translation, handles, array copies.
+// Thin on purpose: nothing here knows about navigation.
+#pragma once
+#include <jni.h>
+
+#include <cstdint>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sample_codec.h"
+
+namespace pdnav::jni {
+
+/// A Java exception to raise, by class name (thrown in C++, translated at the boundary).
+struct JavaError : std::runtime_error {
+  JavaError(const char* java_class, const std::string& message)
+      : std::runtime_error(message), cls(java_class) {}
+  const char* cls;
+};
+
+inline constexpr const char* kIllegalState = "java/lang/IllegalStateException";
+inline constexpr const char* kIllegalArgument = "java/lang/IllegalArgumentException";
+inline constexpr const char* kIo = "java/io/IOException";
+inline constexpr const char* kRuntime = "java/lang/RuntimeException";
+
+/// Throws the pending C++ exception as a Java exception (call inside a catch block).
+void throw_current_as_java(JNIEnv* env) noexcept;
+
+/// Runs f; any C++ exception becomes a Java exception and `fallback` is returned.
+template <class R, class F>
+R guarded(JNIEnv* env, R fallback, F&& f) noexcept {
+  try {
+    return f();
+  } catch (...) {
+    throw_current_as_java(env);
+    return fallback;
+  }
+}
+template <class F>
+void guarded_void(JNIEnv* env, F&& f) noexcept {
+  try {
+    f();
+  } catch (...) {
+    throw_current_as_java(env);
+  }
+}
+
+/// A native object owned by a Java handle; every call on it holds `mutex`.
+template <class T>
+struct Handle {
+  template <class... A>
+  explicit Handle(A&&... args) : object(std::forward<A>(args)...) {}
+  std::mutex mutex;
+  T object;
+};
+
+template <class T>
+jlong to_handle(Handle<T>* h) { return static_cast<jlong>(reinterpret_cast<std::intptr_t>(h)); }
+
+/// The handle's object, or IllegalStateException for a null/closed (0) handle.
+template <class T>
+Handle<T>& from_handle(jlong handle, const char* what) {
+  if (handle == 0) throw JavaError(kIllegalState, std::string(what) + " is closed");
+  return *reinterpret_cast<Handle<T>*>(static_cast<std::intptr_t>(handle));
+}
+
+/// Java string -> UTF-8 std::string; null -> IllegalArgumentException naming `what`.
+std::string to_string(JNIEnv* env, jstring s, const char* what);
+/// Java String[] -> vector; null array or element -> IllegalArgumentException.
+std::vector<std::string> to_strings(JNIEnv* env, jobjectArray a, const char* what);
+
+/// The Java arrays of a SampleBatch (Kotlin SampleBatch fields, in this order).
+struct JavaBatchArrays {
+  jintArray kinds;
+  jlongArray t_ns;
+  jlongArray ints;
+  jdoubleArray doubles;
+  jobjectArray strings;
+  jbyteArray bytes;
+};
+
+/// n rows copied out of Java arrays (validated: non-null, long enough).
+class CopiedBatch {
+ public:
+  CopiedBatch(JNIEnv* env, jint n, const JavaBatchArrays& a);
+  const BatchView& view() const { return view_; }
+
+ private:
+  std::vector<std::int32_t> kinds_;
+  std::vector<std::int64_t> t_ns_;
+  std::vector<std::int64_t> ints_;
+  std::vector<double> doubles_;
+  std::vector<std::string> strings_;
+  std::vector<std::int8_t> bytes_;
+  BatchView view_;
+};
+
+/// Rows built natively, then copied into Java arrays (validated capacity >= rows).
+class OutBatch {
+ public:
+  explicit OutBatch(std::size_t capacity);
+  BatchOut& rows() { return out_; }
+  /// Copies the first n rows into the Java arrays.
+  void copy_to(JNIEnv* env, std::size_t n, const JavaBatchArrays& a) const;
+
+ private:
+  std::vector<std::int32_t> kinds_;
+  std::vector<std::int64_t> t_ns_;
+  std::vector<std::int64_t> ints_;
+  std::vector<double> doubles_;
+  std::vector<std::string> strings_;
+  std::vector<std::int8_t> bytes_;
+  BatchOut out_;
+};
+
+/// Checks that every array is non-null and holds at least `rows` rows.
+void check_batch_arrays(JNIEnv* env, std::size_t rows, const JavaBatchArrays& a);
+
+}  // namespace pdnav::jni

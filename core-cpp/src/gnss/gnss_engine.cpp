@@ -1,0 +1,295 @@
+#include "pdnav/gnss/gnss_engine.h"
+
+#include <cmath>
+#include <utility>
+
+#include "pdnav/geo/time.h"
+
+namespace pdnav::gnss {
+namespace {
+
+constexpr int kGpsL1CaNavType = 0x0101;  // android.location.GnssNavigationMessage.TYPE_GPS_L1CA
+constexpr double kNominalTravelS = 0.075;
+
+void merge(std::map<std::string, std::int64_t>& into, const std::map<std::string, std::int64_t>& from) {
+  for (const auto& [k, v] : from) into[k] += v;
+}
+
+}  // namespace
+
+struct GnssEngine::Impl {
+  GnssOptions opt;
+  std::shared_ptr<const EphemerisStore> eph;
+  std::shared_ptr<EphemerisStore> owned;  // copy made when Nav rows arrive
+  std::uint64_t seed = 0;
+
+  std::vector<GnssRawSample> pending;
+  std::map<std::string, std::int64_t> excluded;
+  std::vector<EpochSolution> solutions;
+  std::int64_t epochs = 0;
+
+  // previous epoch (TDCP)
+  bool has_prev = false;
+  std::vector<CarrierObservation> prev_obs;
+  GpsTime prev_rx;
+  std::int64_t prev_full_bias_nanos = 0;
+  double prev_bias_nanos = 0.0;
+  std::int64_t prev_hw_disc = kMissingInt;
+
+  RobustKalman kf;
+  CodeSmoother smoother;
+  bool have_pos = false;
+  geo::Ecef last_pos;
+  bool have_frame = false;
+  geo::LocalFrame frame;
+  TimeNs last_t_ns = 0;
+  std::int64_t last_gps_ns = 0;
+  int epochs_since_update = 0;
+  int last_sats_used = 0;
+  std::string last_reason;
+
+  void count(const std::string& reason, std::int64_t n = 1) { excluded[reason] += n; }
+
+  /// Satellite state at the true transmit time (satellite clock removed from the code time).
+  bool sat_state(const Measurement& m, const GpsTime& rx, SatState& out) {
+    if (!eph) { count("ephemeris: no ephemeris"); return false; }
+    std::int64_t tx = m.transmit_gps_ns;
+    if (!m.code_ok()) {
+      if (!have_pos) { count("carrier only: no position yet"); return false; }
+      tx = rx.ns - std::llround(kNominalTravelS * 1e9);
+    }
+    std::string why;
+    for (int pass = 0; pass < 2; ++pass) {
+      auto st = eph->state(m.sat, tx, &why);
+      if (!st) { count("ephemeris: " + why); return false; }
+      out = *st;
+      if (!m.code_ok()) tx = rx.ns - std::llround((out.pos.p_m - last_pos.p_m).norm() / kSpeedOfLight_mps * 1e9);
+      else tx = m.transmit_gps_ns - std::llround(out.clock_bias_s * 1e9);
+    }
+    auto st = eph->state(m.sat, tx, &why);
+    if (!st || !st->pos.p_m.allFinite()) { count("ephemeris: " + (why.empty() ? std::string("numerical failure") : why)); return false; }
+    out = *st;
+    return true;
+  }
+
+  double carrier_hz(const Measurement& m, const SatState& st) const {
+    if (std::isfinite(m.carrier_hz)) return m.carrier_hz;
+    const int ch = m.sat.sys == Constellation::kGlonass && m.glonass_channel != 99 ? m.glonass_channel : st.glonass_channel;
+    return default_carrier_hz(m.sat.sys, ch);
+  }
+
+  void handle_clock_jump(const MeasurementEpoch& ep) {
+    if (prev_hw_disc != kMissingInt && ep.hw_discontinuity != kMissingInt && ep.hw_discontinuity != prev_hw_disc) {
+      count("clock: hardware clock discontinuity (TDCP and KF clock reset)");
+      has_prev = false;
+      kf.reset_clock(0.0, 1e12);
+    }
+    prev_hw_disc = ep.hw_discontinuity;
+  }
+
+  void process(const std::vector<GnssRawSample>& rows) {
+    ++epochs;
+    MeasurementEpoch ep;
+    if (!build_epoch(rows, opt.measurements, ep, excluded)) { count("epoch: no usable measurement"); return; }
+    handle_clock_jump(ep);
+    const double dt = has_prev ? static_cast<double>(ep.rx.ns - prev_rx.ns) * 1e-9 : 0.0;
+    if (has_prev && (!(dt > 0.0) || dt > opt.max_epoch_gap_s)) {
+      count("epoch: gap or time going backwards (no TDCP)");
+      has_prev = false;
+    }
+    const double d_bias_ns = static_cast<double>(ep.full_bias_nanos - prev_full_bias_nanos) + (ep.bias_nanos - prev_bias_nanos);
+    smoother.begin_epoch(has_prev ? dt : 0.0, d_bias_ns * 1e-9 * kSpeedOfLight_mps);
+    std::vector<SppObservation> spp_obs;
+    std::vector<CarrierObservation> car_obs;
+    for (const Measurement& m : ep.meas) {
+      SatState st;
+      if (!sat_state(m, ep.rx, st)) continue;
+      if (m.code_ok()) {
+        std::string why;
+        const double pr = smoother.smooth(SmoothingInput{m.sat, m.pseudorange_m, m.adr_ok() ? m.adr_m : kNaN, m.pr_rate_mps}, &why);
+        if (!why.empty()) count(why);
+        spp_obs.push_back(SppObservation{m.sat, pr, m.cn0_dbhz, carrier_hz(m, st), st});
+      }
+      CarrierObservation c;
+      c.sat = m.sat;
+      c.adr_m = m.adr_ok() ? m.adr_m : kNaN;
+      c.pr_rate_mps = m.pr_rate_mps;
+      c.pr_rate_sigma_mps = m.pr_rate_sigma_mps;
+      c.cn0_dbhz = m.cn0_dbhz;
+      c.state = st;
+      car_obs.push_back(c);
+    }
+    EpochSolution sol;
+    sol.t_ns = ep.t_ns;
+    sol.gps_ns = ep.rx.ns;
+    sol.sats_tracked = static_cast<int>(rows.size());
+    const double tow = geo::gps_ns_to_week_tow(ep.rx.ns).tow_s;
+    const SppSolution spp = solve_spp(spp_obs, have_pos ? last_pos : geo::Ecef(), tow,
+                                      eph ? eph->klobuchar() : nullptr, opt.spp);
+    merge(excluded, spp.excluded);
+    if (!spp.ok) count("spp: " + spp.reason);
+    sol.spp_ok = spp.ok;
+    sol.spp_reason = spp.reason;
+    if (spp.ok) {
+      sol.spp = spp.pos;
+      sol.hdop = spp.hdop;
+      sol.pdop = spp.pdop;
+      sol.sats_used = static_cast<int>(spp.used.size());
+      sol.used_by_sys = spp.used_by_sys();
+      if (!have_pos) { last_pos = spp.pos; have_pos = true; }
+    }
+    DisplacementSolution disp = displacement(car_obs, dt);
+    // carrier phase and Doppler follow the hardware clock; the SPP clock is relative to the
+    // receive time already corrected by FullBiasNanos + BiasNanos, so remove that change
+    if (disp.ok) {
+      disp.clock_change_m -= d_bias_ns * 1e-9 * kSpeedOfLight_mps;
+    }
+    run_filter(spp, disp, dt, sol);
+    if (disp.ok) {
+      sol.tdcp_ok = disp.source == "tdcp";
+      sol.disp_source = disp.source;
+      sol.disp_dt_s = disp.dt_s;
+      sol.tdcp_sats = static_cast<int>(disp.used.size());
+      sol.tdcp_disp_m = geo::ecef_to_enu_rotation(geo::to_geodetic(last_pos)) * disp.disp_ecef_m;
+    }
+    prev_obs = std::move(car_obs);
+    prev_rx = ep.rx;
+    prev_full_bias_nanos = ep.full_bias_nanos;
+    prev_bias_nanos = ep.bias_nanos;
+    has_prev = true;
+    last_t_ns = ep.t_ns;
+    last_gps_ns = ep.rx.ns;
+    last_sats_used = sol.sats_used;
+    solutions.push_back(sol);
+  }
+
+  DisplacementSolution displacement(const std::vector<CarrierObservation>& obs, double dt) {
+    DisplacementSolution none;
+    if (!has_prev || !have_pos) return none;
+    DisplacementSolution d = solve_tdcp(prev_obs, obs, dt, last_pos, opt.tdcp);
+    merge(excluded, d.excluded);
+    if (d.ok || !opt.use_doppler_fallback) {
+      if (!d.ok) count("tdcp: " + d.reason);
+      return d;
+    }
+    DisplacementSolution v = solve_doppler(obs, dt, last_pos, opt.tdcp);
+    merge(excluded, v.excluded);
+    if (!v.ok) count("doppler: " + v.reason);
+    return v;
+  }
+
+  void run_filter(const SppSolution& spp, const DisplacementSolution& disp, double dt, EpochSolution& sol) {
+    if (kf.initialized()) {
+      if (disp.ok) kf.predict(disp.disp_ecef_m, disp.cov_ecef_m2, disp.clock_change_m, disp.clock_change_var_m2);
+      else kf.coast(dt > 0.0 ? dt : 1.0);
+    }
+    ++epochs_since_update;
+    if (spp.ok) {
+      const bool was_initialized = kf.initialized();
+      const KalmanUpdateResult u = kf.update(spp.pos, spp.pos_cov_ecef, spp.clock_m, spp.clock_var_m2);
+      sol.kf_update_accepted = u.accepted;
+      if (u.accepted) epochs_since_update = 0;
+      else count("kf: SPP fix rejected (posterior residual^2/var > 36)");
+      if (u.reset && was_initialized) count("kf: reset to the SPP fix");
+    }
+    if (!kf.initialized()) return;
+    sol.kf_ok = true;
+    sol.kf = kf.position();
+    sol.clock_m = kf.clock_m();
+    sol.kf_cov_enu = kf.position_cov_enu();
+    last_pos = kf.position();
+    if (!have_frame) { frame = geo::LocalFrame(geo::to_geodetic(last_pos)); have_frame = true; }
+  }
+};
+
+GnssEngine::GnssEngine(const GnssOptions& options, std::shared_ptr<const EphemerisStore> eph, std::uint64_t seed)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->opt = options;
+  impl_->eph = std::move(eph);
+  impl_->seed = seed;
+  impl_->kf = RobustKalman(options.kalman);
+  impl_->smoother = CodeSmoother(options.smoothing);
+}
+
+GnssEngine::~GnssEngine() = default;
+GnssEngine::GnssEngine(GnssEngine&&) noexcept = default;
+GnssEngine& GnssEngine::operator=(GnssEngine&&) noexcept = default;
+
+void GnssEngine::feed(const GnssRawSample& s) {
+  Impl& m = *impl_;
+  if (s.time_nanos == kMissingInt) { m.count("row: TimeNanos missing"); return; }
+  if (!m.pending.empty() && m.pending.front().time_nanos != s.time_nanos) flush();
+  m.pending.push_back(s);
+}
+
+void GnssEngine::feed(const NavMessageSample& s) {
+  Impl& m = *impl_;
+  if (s.type != kGpsL1CaNavType) { m.count("nav: unsupported message type"); return; }
+  if (m.last_gps_ns == 0) { m.count("nav: no GPS time yet for the week number"); return; }
+  if (!m.owned) {
+    m.owned = m.eph ? std::make_shared<EphemerisStore>(*m.eph) : std::make_shared<EphemerisStore>();
+    m.eph = m.owned;
+  }
+  std::string why;
+  m.owned->add_gps_lnav_subframe(s.svid, s.sub_message_id, s.data, geo::gps_ns_to_week_tow(m.last_gps_ns).week, &why);
+  if (!why.empty()) m.count("nav: " + why);
+}
+
+void GnssEngine::flush() {
+  Impl& m = *impl_;
+  if (m.pending.empty()) return;
+  std::vector<GnssRawSample> rows;
+  rows.swap(m.pending);
+  m.process(rows);
+}
+
+void GnssEngine::reset() {
+  Impl& m = *impl_;
+  m.kf = RobustKalman(m.opt.kalman);
+  m.smoother.reset();
+  m.has_prev = false;
+  m.have_pos = false;
+  m.epochs_since_update = 0;
+}
+
+Estimate GnssEngine::estimate() const {
+  const Impl& m = *impl_;
+  Estimate e;
+  e.engine = EngineKind::kGnss;
+  e.t_ns = m.last_t_ns;
+  if (!m.kf.initialized()) {
+    e.reason = "GNSS: no fix yet";
+    return e;
+  }
+  e.position = geo::to_geodetic(m.kf.position());
+  e.en_m = m.frame.to_enu(m.kf.position()).p_m.head<2>();
+  const Eigen::Matrix3d cov = m.kf.position_cov_enu();
+  e.cov_en_m2 = cov.topLeftCorner<2, 2>();
+  e.vertical_sigma_m = std::sqrt(std::max(cov(2, 2), 0.0));
+  if (m.epochs_since_update >= m.opt.lost_after_epochs) {
+    e.status = EstimateStatus::kLost;
+    e.reason = "GNSS: no accepted fix for " + std::to_string(m.epochs_since_update) + " epochs";
+  } else if (m.epochs_since_update > 0) {
+    e.status = EstimateStatus::kDegraded;
+    e.reason = "GNSS: coasting on carrier phase / Doppler";
+  } else if (m.last_sats_used < m.opt.min_sats_ok) {
+    e.status = EstimateStatus::kDegraded;
+    e.reason = "GNSS: few satellites (" + std::to_string(m.last_sats_used) + ")";
+  } else {
+    e.status = EstimateStatus::kOk;
+    e.reason = "GNSS: SPP + TDCP Kalman filter";
+  }
+  return e;
+}
+
+std::vector<EpochSolution> GnssEngine::take_solutions() {
+  std::vector<EpochSolution> out;
+  out.swap(impl_->solutions);
+  return out;
+}
+
+const std::map<std::string, std::int64_t>& GnssEngine::exclusions() const { return impl_->excluded; }
+std::int64_t GnssEngine::epochs() const { return impl_->epochs; }
+std::uint64_t GnssEngine::seed() const { return impl_->seed; }
+
+}  // namespace pdnav::gnss

@@ -1,0 +1,233 @@
+#include "pdnav/gnss/measurements.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pdnav/geo/time.h"
+
+namespace pdnav::gnss {
+namespace {
+
+constexpr std::int64_t kNs100Ms = 100 * kNsPerMs;
+constexpr std::int64_t kNsPerHour = 3600 * kNsPerS;
+
+/// a mod m in [0, m).
+std::int64_t floor_mod(std::int64_t a, std::int64_t m) {
+  const std::int64_t r = a % m;
+  return r < 0 ? r + m : r;
+}
+
+/// d wrapped to (-period/2, period/2].
+std::int64_t wrap_half(std::int64_t d, std::int64_t period) {
+  d = floor_mod(d, period);
+  return d > period / 2 ? d - period : d;
+}
+
+bool has(std::int64_t state, std::int64_t bit) { return (state & bit) != 0; }
+
+bool finite_and_small(double v, double limit) { return std::isfinite(v) && std::fabs(v) < limit; }
+
+double ns_to_m(std::int64_t d_ns, double frac_ns) {
+  return (static_cast<double>(d_ns) + frac_ns) * 1e-9 * kSpeedOfLight_mps;
+}
+
+/// Week-based time of week (GPS, Galileo, QZSS, BeiDou after the BDT offset).
+double week_based_pr_m(std::int64_t rx_ns, double frac_ns, std::int64_t sv_ns) {
+  const std::int64_t tow_ns = floor_mod(rx_ns, geo::kNsPerWeek);
+  return ns_to_m(wrap_half(tow_ns - sv_ns, geo::kNsPerWeek), frac_ns);
+}
+
+double gps_like_pr_m(const GnssRawSample& r, const GpsTime& rx, std::string& reason) {
+  const bool tow = has(r.state, state_bit::kTowDecoded) || has(r.state, state_bit::kTowKnown);
+  if (!tow || has(r.state, state_bit::kMsecAmbiguous)) {
+    reason = "code: time of week not decoded";
+    return kNaN;
+  }
+  return week_based_pr_m(rx.ns, rx.frac_ns, r.received_sv_time_nanos);
+}
+
+double galileo_pr_m(const GnssRawSample& r, const GpsTime& rx, std::string& reason) {
+  if (has(r.state, state_bit::kTowDecoded) || has(r.state, state_bit::kTowKnown))
+    return week_based_pr_m(rx.ns, rx.frac_ns, r.received_sv_time_nanos);
+  if (!has(r.state, state_bit::kGalE1c2ndCodeLock)) {
+    reason = "code: Galileo neither TOW nor E1C secondary code lock";
+    return kNaN;
+  }
+  // E1C secondary code: ReceivedSvTime is known modulo 100 ms; Galileo ranges are 77-97 ms.
+  std::int64_t d = floor_mod(floor_mod(rx.ns, kNs100Ms) - floor_mod(r.received_sv_time_nanos, kNs100Ms), kNs100Ms);
+  if (d < kNs100Ms / 2) d += kNs100Ms;
+  return ns_to_m(d, rx.frac_ns);
+}
+
+double beidou_pr_m(const GnssRawSample& r, const GpsTime& rx, std::string& reason) {
+  if (!(has(r.state, state_bit::kTowDecoded) || has(r.state, state_bit::kTowKnown))) {
+    reason = "code: time of week not decoded";
+    return kNaN;
+  }
+  const std::int64_t rx_bdt_ns = rx.ns - 14 * kNsPerS;  // BDT = GPST - 14 s
+  return week_based_pr_m(rx_bdt_ns, rx.frac_ns, r.received_sv_time_nanos);
+}
+
+double glonass_pr_m(const GnssRawSample& r, const GpsTime& rx, int leap_s, std::string& reason) {
+  if (!(has(r.state, state_bit::kGloTodDecoded) || has(r.state, state_bit::kGloTodKnown))) {
+    reason = "code: GLONASS time of day not decoded";
+    return kNaN;
+  }
+  // GLONASS time = UTC(SU) + 3 h; time of day wraps at the GLONASS day boundary.
+  const std::int64_t rx_glo_ns = rx.ns - std::int64_t{leap_s} * kNsPerS + 3 * kNsPerHour;
+  const std::int64_t tod_ns = floor_mod(rx_glo_ns, geo::kNsPerDay);
+  return ns_to_m(wrap_half(tod_ns - r.received_sv_time_nanos, geo::kNsPerDay), rx.frac_ns);
+}
+
+/// ADR fields of a row into the measurement; counted when unusable.
+void fill_adr(const GnssRawSample& r, const MeasurementOptions& opt, Measurement& m, ExclusionCounts& ex) {
+  const std::int64_t st = r.accumulated_delta_range_state;
+  if (st == kMissingInt || !has(st, adr_bit::kValid)) {
+    if (std::isfinite(r.accumulated_delta_range_m) && r.accumulated_delta_range_m != 0.0) ++ex["adr: state not valid"];
+    return;
+  }
+  if (!finite_and_small(r.accumulated_delta_range_m, 1e12)) { ++ex["adr: non-finite value"]; return; }
+  m.adr_reset = has(st, adr_bit::kReset);
+  m.adr_cycle_slip = has(st, adr_bit::kCycleSlip);
+  m.adr_m = r.accumulated_delta_range_m;
+  m.adr_sigma_m = finite_and_small(r.accumulated_delta_range_uncertainty_m, opt.max_uncertainty)
+                      ? r.accumulated_delta_range_uncertainty_m : kNaN;
+  if (m.adr_reset) ++ex["adr: reset"];
+  if (m.adr_cycle_slip) ++ex["adr: cycle slip"];
+}
+
+/// Pseudorange rate fields of a row.
+void fill_rate(const GnssRawSample& r, const MeasurementOptions& opt, Measurement& m, ExclusionCounts& ex) {
+  if (!finite_and_small(r.pseudorange_rate_mps, 1e5)) {
+    ++ex["doppler: missing or non-finite"];
+    return;
+  }
+  m.pr_rate_mps = r.pseudorange_rate_mps;
+  m.pr_rate_sigma_mps = finite_and_small(r.pseudorange_rate_uncertainty_mps, opt.max_uncertainty)
+                            ? r.pseudorange_rate_uncertainty_mps : kNaN;
+}
+
+/// Pseudorange fields of a row; NaN pseudorange (counted) when the code phase is unusable.
+void fill_code(const GnssRawSample& r, const GpsTime& rx, int leap_s, const MeasurementOptions& opt,
+               Measurement& m, ExclusionCounts& ex) {
+  std::string reason;
+  if (r.received_sv_time_nanos == kMissingInt || r.received_sv_time_nanos < 0) {
+    ++ex["code: ReceivedSvTimeNanos missing"];
+    return;
+  }
+  const double pr = pseudorange_m(r, rx, leap_s, reason);
+  if (!std::isfinite(pr)) { ++ex[reason]; return; }
+  if (pr < opt.min_pseudorange_m || pr > opt.max_pseudorange_m) { ++ex["code: pseudorange out of range"]; return; }
+  double sigma = kNaN;
+  if (r.received_sv_time_uncertainty_nanos != kMissingInt && r.received_sv_time_uncertainty_nanos >= 0)
+    sigma = static_cast<double>(r.received_sv_time_uncertainty_nanos) * 1e-9 * kSpeedOfLight_mps;
+  if (std::isfinite(sigma) && sigma > opt.max_pr_sigma_m) { ++ex["code: uncertainty too large"]; return; }
+  m.pseudorange_m = pr;
+  m.pseudorange_sigma_m = sigma;
+  m.transmit_gps_ns = rx.ns - std::llround(pr / kSpeedOfLight_mps * 1e9);
+}
+
+/// True for the L1-band signal the solver uses (GPS/QZSS L1, Galileo E1, BeiDou B1I/B1C,
+/// GLONASS L1OF); L5/E5a/B2a and other bands would need their own group delays.
+bool l1_band(Constellation sys, double carrier_hz) {
+  if (!std::isfinite(carrier_hz)) return true;  // old logs have no frequency column: L1
+  if (sys == Constellation::kGlonass) return carrier_hz > 1590e6 && carrier_hz < 1610e6;
+  if (sys == Constellation::kBeidou) return carrier_hz > 1555e6 && carrier_hz < 1580e6;
+  return std::fabs(carrier_hz - 1575.42e6) < 10e6;
+}
+
+/// Keeps one signal per satellite (the strongest), counting the others.
+void drop_duplicates(std::vector<Measurement>& meas, ExclusionCounts& excluded) {
+  std::vector<Measurement> out;
+  for (const Measurement& m : meas) {
+    auto it = std::find_if(out.begin(), out.end(), [&](const Measurement& o) { return o.sat == m.sat; });
+    if (it == out.end()) { out.push_back(m); continue; }
+    ++excluded["signal: duplicate satellite in epoch"];
+    if (m.cn0_dbhz > it->cn0_dbhz) *it = m;
+  }
+  meas.swap(out);
+}
+
+bool supported(Constellation c) {
+  return c == Constellation::kGps || c == Constellation::kGlonass || c == Constellation::kGalileo ||
+         c == Constellation::kBeidou || c == Constellation::kQzss;
+}
+
+}  // namespace
+
+double default_carrier_hz(Constellation sys, int glonass_channel) {
+  switch (sys) {
+    case Constellation::kGps: case Constellation::kQzss: case Constellation::kGalileo:
+    case Constellation::kSbas: return 1575.42e6;
+    case Constellation::kBeidou: return 1561.098e6;
+    case Constellation::kGlonass: return 1602.0e6 + glonass_channel * 0.5625e6;
+    case Constellation::kIrnss: return 1176.45e6;
+    default: return kNaN;
+  }
+}
+
+bool receive_gps_time(const GnssRawSample& r, GpsTime& out) {
+  if (r.time_nanos == kMissingInt || r.full_bias_nanos == kMissingInt) return false;
+  const double offset = (std::isfinite(r.time_offset_nanos) ? r.time_offset_nanos : 0.0) -
+                        (std::isfinite(r.bias_nanos) ? r.bias_nanos : 0.0);
+  if (std::fabs(offset) > 1e9) return false;
+  const double whole = std::floor(offset);
+  out.ns = r.time_nanos - r.full_bias_nanos + static_cast<std::int64_t>(whole);
+  out.frac_ns = offset - whole;
+  return out.ns > 0;
+}
+
+double pseudorange_m(const GnssRawSample& r, const GpsTime& rx, int leap_seconds, std::string& reason) {
+  if (!has(r.state, state_bit::kCodeLock)) { reason = "code: no code lock"; return kNaN; }
+  const SatId sat = SatId::from_android(r.constellation_type, r.svid);
+  switch (sat.sys) {
+    case Constellation::kGps: case Constellation::kQzss: return gps_like_pr_m(r, rx, reason);
+    case Constellation::kGalileo: return galileo_pr_m(r, rx, reason);
+    case Constellation::kBeidou: return beidou_pr_m(r, rx, reason);
+    case Constellation::kGlonass: return glonass_pr_m(r, rx, leap_seconds, reason);
+    default: reason = "unsupported constellation"; return kNaN;
+  }
+}
+
+bool build_epoch(const std::vector<GnssRawSample>& rows, const MeasurementOptions& opt,
+                 MeasurementEpoch& out, ExclusionCounts& excluded) {
+  out = MeasurementEpoch{};
+  if (rows.empty()) return false;
+  const GnssRawSample& c = rows.front();
+  out.t_ns = c.t_ns;
+  out.time_nanos = c.time_nanos;
+  out.hw_discontinuity = c.hardware_clock_discontinuity_count;
+  if (!receive_gps_time(c, out.rx)) {
+    excluded["epoch: no GPS time (FullBiasNanos missing)"] += static_cast<std::int64_t>(rows.size());
+    return false;
+  }
+  out.full_bias_nanos = c.full_bias_nanos;
+  out.bias_nanos = std::isfinite(c.bias_nanos) ? c.bias_nanos : 0.0;
+  if (finite_and_small(c.drift_nanos_per_second, 1e9))
+    out.clock_drift_mps = c.drift_nanos_per_second * 1e-9 * kSpeedOfLight_mps;
+  out.leap_seconds = (c.leap_second != kMissingInt && c.leap_second >= 0 && c.leap_second < 100)
+                         ? static_cast<int>(c.leap_second) : geo::leap_seconds_at_gps_ns(out.rx.ns);
+  for (const GnssRawSample& r : rows) {
+    Measurement m;
+    m.sat = SatId::from_android(r.constellation_type, r.svid);
+    if (!supported(m.sat.sys)) { ++excluded["unsupported constellation"]; continue; }
+    if (!std::isfinite(r.cn0_dbhz)) { ++excluded["cn0: missing"]; continue; }
+    if (r.cn0_dbhz < opt.min_cn0_dbhz) { ++excluded["cn0 < 15 dB-Hz"]; continue; }
+    m.cn0_dbhz = r.cn0_dbhz;
+    if (m.sat.sys == Constellation::kGlonass && r.svid >= 93 && r.svid <= 106) m.glonass_channel = r.svid - 100;
+    if (finite_and_small(r.carrier_frequency_hz, 1e10) && r.carrier_frequency_hz > 1e8) m.carrier_hz = r.carrier_frequency_hz;
+    if (!l1_band(m.sat.sys, m.carrier_hz)) { ++excluded["signal: not L1/E1/B1 (one band used)"]; continue; }
+    // TimeOffsetNanos is per measurement, so each row has its own receive time
+    GpsTime rx;
+    if (!receive_gps_time(r, rx)) { ++excluded["epoch: no GPS time (FullBiasNanos missing)"]; continue; }
+    fill_code(r, rx, out.leap_seconds, opt, m, excluded);
+    fill_rate(r, opt, m, excluded);
+    fill_adr(r, opt, m, excluded);
+    if (!m.code_ok() && !std::isfinite(m.pr_rate_mps) && !std::isfinite(m.adr_m)) continue;
+    out.meas.push_back(m);
+  }
+  drop_duplicates(out.meas, excluded);
+  return !out.meas.empty();
+}
+
+}  // namespace pdnav::gnss

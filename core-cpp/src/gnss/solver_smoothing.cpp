@@ -1,0 +1,43 @@
+#include "pdnav/gnss/solver_smoothing.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pdnav::gnss {
+
+void CodeSmoother::begin_epoch(double dt_s, double clock_jump_m) {
+  ++epoch_;
+  dt_s_ = dt_s;
+  clock_jump_m_ = std::isfinite(clock_jump_m) ? clock_jump_m : 0.0;
+  if (!(dt_s > 0.0)) sats_.clear();
+}
+
+double CodeSmoother::smooth(const SmoothingInput& in, std::string* reason) {
+  if (!std::isfinite(in.pseudorange_m)) return in.pseudorange_m;
+  Sat& s = sats_[in.sat];
+  const bool continuous = s.epoch == epoch_ - 1 && dt_s_ > 0.0 && opt_.window_s > 0.0;
+  double delta = std::nan("");
+  if (continuous && std::isfinite(in.adr_m) && std::isfinite(s.adr_m)) {
+    delta = in.adr_m - s.adr_m - clock_jump_m_;
+  } else if (continuous && std::isfinite(in.pr_rate_mps) && std::isfinite(s.pr_rate_mps)) {
+    delta = 0.5 * (in.pr_rate_mps + s.pr_rate_mps) * dt_s_ - clock_jump_m_;
+  }
+  const double predicted = s.pr_sm_m + delta;
+  if (std::isfinite(delta) && std::fabs(in.pseudorange_m - predicted) > opt_.max_jump_m) {
+    if (reason != nullptr) *reason = "smoothing: code-carrier jump (restarted)";
+    delta = std::nan("");
+  }
+  if (std::isfinite(delta)) {
+    s.n = std::min(s.n + 1.0, std::max(1.0, opt_.window_s / dt_s_));
+    s.pr_sm_m = in.pseudorange_m / s.n + (s.n - 1.0) / s.n * predicted;
+  } else {
+    s.n = 1.0;
+    s.pr_sm_m = in.pseudorange_m;
+  }
+  s.adr_m = in.adr_m;
+  s.pr_rate_mps = in.pr_rate_mps;
+  s.epoch = epoch_;
+  return s.pr_sm_m;
+}
+
+}  // namespace pdnav::gnss

@@ -1,0 +1,152 @@
+#include "pdnav/gnss/sp3.h"
+
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+#include "pdnav/geo/time.h"
+#include "pdnav/gnss/rinex.h"
+
+namespace pdnav::gnss {
+namespace {
+
+std::string field(const std::string& line, std::size_t col, std::size_t width) {
+  if (col >= line.size()) return {};
+  return line.substr(col, width);
+}
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r");
+  if (b == std::string::npos) return {};
+  return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
+}
+
+class Sp3Parser {
+ public:
+  Sp3Parser(std::istream& in, std::string name) : in_(in), name_(std::move(name)) {}
+
+  Sp3File run() {
+    std::string l;
+    if (!next(l)) fail("empty file");
+    if (l.size() < 3 || l[0] != '#' || (l[1] != 'c' && l[1] != 'd' && l[1] != 'a' && l[1] != 'b'))
+      fail("not an SP3 file (first line must start with #c or #d)");
+    out_.version = l[1];
+    while (next(l)) {
+      if (l.rfind("EOF", 0) == 0) break;
+      if (l.rfind("%c", 0) == 0 && !time_system_seen_) {
+        time_system_seen_ = true;
+        const std::string ts = trim(field(l, 9, 3));
+        if (!ts.empty() && ts != "ccc") out_.time_system = ts;
+        offset_check();
+      } else if (l[0] == '*') {
+        epoch_line(l);
+      } else if (l[0] == 'P') {
+        position_line(l);
+      }  // '+', '++', '%f', '%i', '/*', 'V', 'EP', 'EV': not needed
+    }
+    return std::move(out_);
+  }
+
+ private:
+  bool next(std::string& l) {
+    if (!std::getline(in_, l)) return false;
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+    ++line_no_;
+    if (l.empty()) l = " ";
+    return true;
+  }
+
+  [[noreturn]] void fail(const std::string& reason) const {
+    throw std::runtime_error(name_ + ":" + std::to_string(line_no_) + ": " + reason);
+  }
+
+  void offset_check() const {
+    const std::string& ts = out_.time_system;
+    if (ts != "GPS" && ts != "GAL" && ts != "UTC" && ts != "TAI" && ts != "BDT")
+      fail("unsupported SP3 time system '" + ts + "'");
+  }
+
+  double number(const std::string& f) const {
+    const auto v = parse_rinex_double(f);
+    if (!v) fail("non-numeric field '" + trim(f) + "'");
+    return *v;
+  }
+
+  TimeNs to_gps_ns(double calendar_s) const {
+    const std::string& ts = out_.time_system;
+    double gps_s = calendar_s;
+    if (ts == "UTC") {
+      const auto unix_ms = static_cast<std::int64_t>(std::llround(calendar_s * 1e3)) + geo::kGpsEpochUnixMs;
+      gps_s += geo::leap_seconds_at_unix_ms(unix_ms);
+    } else if (ts == "TAI") {
+      gps_s -= 19.0;
+    } else if (ts == "BDT") {
+      gps_s += 14.0;
+    }
+    return static_cast<TimeNs>(std::llround(gps_s * 1e9));
+  }
+
+  int integer(const std::string& f) const {
+    const double v = number(f);
+    if (!(std::abs(v) < 1e6)) fail("bad epoch");
+    return static_cast<int>(v);
+  }
+
+  void epoch_line(const std::string& l) {
+    const int y = integer(field(l, 3, 4));
+    const int mo = integer(field(l, 8, 2));
+    const int d = integer(field(l, 11, 2));
+    const int h = integer(field(l, 14, 2));
+    const int mi = integer(field(l, 17, 2));
+    const double s = number(field(l, 20, 11));
+    if (y < 1980 || y > 2200 || mo < 1 || mo > 12 || d < 1 || d > 31 || h < 0 || h > 23 || mi < 0 || mi > 59 || s < 0 ||
+        s >= 61)
+      fail("bad epoch");
+    Sp3Epoch e;
+    e.gps_ns = to_gps_ns(geo::calendar_to_epoch_seconds(y, mo, d, h, mi, s));
+    out_.epochs.push_back(std::move(e));
+  }
+
+  void position_line(const std::string& l) {
+    if (out_.epochs.empty()) fail("position record before the first epoch");
+    SatId sat;
+    sat.sys = constellation_from_rinex_letter(l.size() > 1 ? l[1] : '?');
+    const auto prn = parse_rinex_double(field(l, 2, 2));
+    const auto x = parse_rinex_double(field(l, 4, 14));
+    const auto y = parse_rinex_double(field(l, 18, 14));
+    const auto z = parse_rinex_double(field(l, 32, 14));
+    const auto c = parse_rinex_double(field(l, 46, 14));
+    if (sat.sys == Constellation::kUnknown || !prn || *prn < 1 || *prn > 99 || !x || !y || !z || l.size() < 46) {
+      ++out_.skipped_lines;
+      return;
+    }
+    if (*x == 0.0 && *y == 0.0 && *z == 0.0) {  // SP3: bad or absent position
+      ++out_.skipped_lines;
+      return;
+    }
+    sat.prn = static_cast<int>(*prn);
+    Sp3Sample s;
+    s.pos = geo::Ecef(*x * 1e3, *y * 1e3, *z * 1e3);
+    s.has_clock = c && std::abs(*c) < 999999.0 && trim(field(l, 46, 14)) != "";
+    s.clock_s = s.has_clock ? *c * 1e-6 : 0.0;
+    out_.epochs.back().sats[sat] = s;
+  }
+
+  std::istream& in_;
+  std::string name_;
+  int line_no_ = 0;
+  bool time_system_seen_ = false;
+  Sp3File out_;
+};
+
+}  // namespace
+
+Sp3File read_sp3(std::istream& in, const std::string& name) { return Sp3Parser(in, name).run(); }
+
+Sp3File read_sp3_file(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw std::runtime_error(path + ":0: cannot open");
+  return read_sp3(f, path);
+}
+
+}  // namespace pdnav::gnss

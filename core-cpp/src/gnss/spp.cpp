@@ -1,0 +1,308 @@
+#include "pdnav/gnss/spp.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Dense>
+
+#include "pdnav/geo/units.h"
+
+namespace pdnav::gnss {
+namespace {
+
+constexpr double kL1Hz = 1575.42e6;
+constexpr double kNearSurfaceMinM = 6.0e6;   // iterate is "on Earth" between these radii
+constexpr double kNearSurfaceMaxM = 7.0e6;
+
+/// Unknowns: x, y, z, clock of the reference system, one ISB per other system.
+struct Layout {
+  Constellation ref = Constellation::kGps;
+  std::map<Constellation, int> isb_col;  // system -> column (>= 4)
+  int cols = 4;
+};
+
+Layout make_layout(const std::vector<const SppObservation*>& obs) {
+  std::map<Constellation, int> count;
+  for (const auto* o : obs) ++count[o->sat.sys];
+  Layout l;
+  l.ref = count.count(Constellation::kGps) ? Constellation::kGps : count.begin()->first;
+  for (const auto& [sys, n] : count) {
+    if (sys == l.ref) continue;
+    l.isb_col[sys] = l.cols++;
+  }
+  return l;
+}
+
+struct Row {
+  double residual_m = 0.0;   // measured - modelled
+  Eigen::Vector3d los = Eigen::Vector3d::Zero();  // unit vector receiver -> satellite
+  double var_m2 = 1.0;
+  double el_rad = kPi / 2;
+  bool masked = false;
+};
+
+/// Model of one pseudorange at the iterate x (ECEF + clocks).
+Row model_row(const SppObservation& o, const Eigen::VectorXd& x, const Layout& l, double tow_s,
+              const KlobucharParams* klob, const SppOptions& opt) {
+  Row r;
+  const Eigen::Vector3d rx = x.head<3>();
+  Eigen::Vector3d sat = o.state.pos.p_m;
+  double range = (sat - rx).norm();
+  for (int k = 0; k < 2; ++k) {  // travel time depends on the rotated position; converges at once
+    sat = rotate_for_travel_time(o.state.pos.p_m, range / kSpeedOfLight_mps);
+    range = (sat - rx).norm();
+  }
+  r.los = (sat - rx) / range;
+  double clock = x(3);
+  if (o.sat.sys != l.ref) clock += x(l.isb_col.at(o.sat.sys));
+  double atmo_m = 0.0;
+  const double radius = rx.norm();
+  if (radius > kNearSurfaceMinM && radius < kNearSurfaceMaxM) {
+    const geo::Ecef rx_ecef(rx);
+    const AzEl ae = azimuth_elevation(rx_ecef, geo::Ecef(sat));
+    r.el_rad = ae.el_rad;
+    r.masked = ae.el_rad < deg_to_rad(opt.elevation_mask_deg);
+    const geo::Geodetic g = geo::to_geodetic(rx_ecef);
+    if (opt.ionosphere && klob != nullptr && ae.el_rad > 0.0) {
+      const double scale = std::pow(kL1Hz / o.carrier_hz, 2);
+      atmo_m += scale * kSpeedOfLight_mps * klobuchar_delay_s(*klob, g, ae.az_rad, ae.el_rad, tow_s);
+    }
+    if (opt.troposphere && ae.el_rad > 0.0) atmo_m += saastamoinen_delay_m(g, ae.el_rad);
+  }
+  const double sat_clock_m = kSpeedOfLight_mps * (o.state.clock_bias_s - o.state.group_delay_s);
+  r.residual_m = o.pseudorange_m - (range + clock - sat_clock_m + atmo_m);
+  r.var_m2 = cn0_elevation_variance(opt.code_var_a_m2, opt.code_var_b_m2, o.cn0_dbhz, r.el_rad);
+  return r;
+}
+
+struct LsResult {
+  bool ok = false;
+  std::string reason;
+  Eigen::VectorXd x;
+  Eigen::MatrixXd cov;           // (H^T W H)^-1
+  std::vector<Row> rows;
+  int iterations = 0;
+};
+
+/// Gauss-Newton on the given observations; masked satellites are dropped from the fit.
+LsResult iterate_ls(const std::vector<const SppObservation*>& obs, const Layout& l, Eigen::VectorXd x,
+                    double tow_s, const KlobucharParams* klob, const SppOptions& opt) {
+  LsResult res;
+  const int n = static_cast<int>(obs.size());
+  for (int it = 0; it < opt.max_iterations; ++it) {
+    res.rows.clear();
+    Eigen::MatrixXd h = Eigen::MatrixXd::Zero(n, l.cols);
+    Eigen::VectorXd y = Eigen::VectorXd::Zero(n), w = Eigen::VectorXd::Zero(n);
+    int used = 0;
+    for (int i = 0; i < n; ++i) {
+      res.rows.push_back(model_row(*obs[i], x, l, tow_s, klob, opt));
+      const Row& r = res.rows.back();
+      if (r.masked) continue;
+      h.block<1, 3>(i, 0) = -r.los.transpose();
+      h(i, 3) = 1.0;
+      if (obs[i]->sat.sys != l.ref) h(i, l.isb_col.at(obs[i]->sat.sys)) = 1.0;
+      y(i) = r.residual_m;
+      w(i) = 1.0 / r.var_m2;
+      ++used;
+    }
+    if (used < l.cols) { res.reason = "fewer satellites than unknowns"; return res; }
+    const Eigen::MatrixXd n_mat = h.transpose() * w.asDiagonal() * h;
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(n_mat);
+    if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > opt.min_rcond)) { res.reason = "singular geometry"; return res; }
+    const Eigen::VectorXd dx = ldlt.solve(h.transpose() * w.asDiagonal() * y);
+    if (!dx.allFinite()) { res.reason = "numerical failure"; return res; }
+    x += dx;
+    res.iterations = it + 1;
+    if (dx.head<3>().norm() < opt.convergence_m && x.head<3>().norm() > kNearSurfaceMinM) {
+      res.cov = ldlt.solve(Eigen::MatrixXd::Identity(l.cols, l.cols));
+      // final rows at the converged state
+      for (int i = 0; i < n; ++i) res.rows[static_cast<std::size_t>(i)] = model_row(*obs[i], x, l, tow_s, klob, opt);
+      res.x = x;
+      res.ok = true;
+      return res;
+    }
+  }
+  res.reason = "least squares did not converge";
+  return res;
+}
+
+Eigen::VectorXd initial_state(const Layout& l, const geo::Ecef& initial) {
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(l.cols);
+  if (initial.p_m.allFinite()) x.head<3>() = initial.p_m;
+  return x;
+}
+
+/// Drops satellites whose system has a single satellite (it only determines its own ISB).
+std::vector<const SppObservation*> usable(const std::vector<SppObservation>& obs, const SppOptions& opt,
+                                          std::map<std::string, std::int64_t>& excluded) {
+  std::map<Constellation, int> count;
+  for (const auto& o : obs) ++count[o.sat.sys];
+  std::vector<const SppObservation*> out;
+  for (const auto& o : obs) {
+    if (!std::isfinite(o.pseudorange_m) || !o.state.pos.p_m.allFinite() || !std::isfinite(o.cn0_dbhz)) {
+      ++excluded["spp: non-finite input"];
+      continue;
+    }
+    if (opt.drop_single_sat_systems && count[o.sat.sys] == 1 && count.size() > 1) {
+      ++excluded["spp: single satellite of its system"];
+      continue;
+    }
+    out.push_back(&o);
+  }
+  return out;
+}
+
+/// Classical (unweighted) DOPs from the geometry; false when the geometry is singular.
+bool fill_dop(const LsResult& ls, const std::vector<const SppObservation*>& obs, const Layout& l, SppSolution& s) {
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(obs.size()), l.cols);
+  Eigen::Index k = 0;
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    const Row& r = ls.rows[i];
+    if (r.masked) continue;
+    h.block<1, 3>(k, 0) = -r.los.transpose();
+    h(k, 3) = 1.0;
+    if (obs[i]->sat.sys != l.ref) h(k, l.isb_col.at(obs[i]->sat.sys)) = 1.0;
+    ++k;
+  }
+  const Eigen::MatrixXd n_mat = h.topRows(k).transpose() * h.topRows(k);
+  const Eigen::FullPivLU<Eigen::MatrixXd> lu(n_mat);
+  if (!lu.isInvertible()) return false;
+  const Eigen::MatrixXd q = lu.inverse();
+  const Eigen::Matrix3d r = geo::ecef_to_enu_rotation(geo::to_geodetic(s.pos));
+  const Eigen::Matrix3d q_enu = r * q.topLeftCorner<3, 3>() * r.transpose();
+  s.gdop = std::sqrt(std::max(0.0, q.trace()));
+  s.pdop = std::sqrt(std::max(0.0, q_enu.trace()));
+  s.hdop = std::sqrt(std::max(0.0, q_enu(0, 0) + q_enu(1, 1)));
+  s.vdop = std::sqrt(std::max(0.0, q_enu(2, 2)));
+  return std::isfinite(s.gdop);
+}
+
+SppSolution to_solution(const LsResult& ls, const std::vector<const SppObservation*>& obs, const Layout& l) {
+  SppSolution s;
+  s.ok = true;
+  s.pos = geo::Ecef(ls.x.head<3>());
+  s.clock_m = ls.x(3);
+  s.clock_system = l.ref;
+  for (const auto& [sys, col] : l.isb_col) s.isb_m[sys] = ls.x(col);
+  s.pos_cov_ecef = ls.cov.topLeftCorner<3, 3>();
+  s.clock_var_m2 = ls.cov(3, 3);
+  s.iterations = ls.iterations;
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    const Row& r = ls.rows[i];
+    if (r.masked) continue;
+    s.used.push_back(obs[i]->sat);
+    s.residuals_m.push_back(r.residual_m);
+    s.elevations_rad.push_back(r.el_rad);
+    s.chi2 += r.residual_m * r.residual_m / r.var_m2;
+  }
+  return s;
+}
+
+/// Index (into obs) of the unmasked satellite with the largest normalised residual.
+std::size_t worst_satellite(const LsResult& ls) {
+  std::size_t worst = 0;
+  double worst_v = -1.0;
+  for (std::size_t i = 0; i < ls.rows.size(); ++i) {
+    if (ls.rows[i].masked) continue;
+    const double v = ls.rows[i].residual_m * ls.rows[i].residual_m / ls.rows[i].var_m2;
+    if (v > worst_v) { worst_v = v; worst = i; }
+  }
+  return worst;
+}
+
+/// Upper quantile z of the standard normal: P(Z > z) = p (bisection on erfc).
+double normal_upper_quantile(double p) {
+  double lo = -10.0, hi = 10.0;
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    if (0.5 * std::erfc(mid / std::sqrt(2.0)) > p) lo = mid; else hi = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+double cn0_elevation_variance(double a, double b, double cn0_dbhz, double el_rad) {
+  const double s = std::max(std::sin(el_rad), 0.1);
+  return a / (s * s) + b * std::pow(10.0, -cn0_dbhz / 10.0);
+}
+
+double chi_square_quantile(double p_false_alarm, int dof) {
+  if (dof < 1 || !(p_false_alarm > 0.0 && p_false_alarm < 1.0)) return kNaN;
+  if (dof == 1) { const double z = normal_upper_quantile(0.5 * p_false_alarm); return z * z; }  // exact
+  if (dof == 2) return -2.0 * std::log(p_false_alarm);                                              // exact
+  const double z = normal_upper_quantile(p_false_alarm);
+  const double k = dof;
+  const double t = 1.0 - 2.0 / (9.0 * k) + z * std::sqrt(2.0 / (9.0 * k));
+  return k * t * t * t;
+}
+
+Eigen::Vector3d rotate_for_travel_time(const Eigen::Vector3d& sat_ecef_m, double travel_s) {
+  const double a = geo::Wgs84::omega_e_radps * travel_s;
+  const double c = std::cos(a), s = std::sin(a);
+  return {c * sat_ecef_m.x() + s * sat_ecef_m.y(), -s * sat_ecef_m.x() + c * sat_ecef_m.y(), sat_ecef_m.z()};
+}
+
+std::map<Constellation, int> SppSolution::used_by_sys() const {
+  std::map<Constellation, int> m;
+  for (const SatId& s : used) ++m[s.sys];
+  return m;
+}
+
+SppSolution solve_spp(const std::vector<SppObservation>& all, const geo::Ecef& initial, double gps_tow_s,
+                      const KlobucharParams* klob, const SppOptions& opt) {
+  std::map<std::string, std::int64_t> excluded;
+  std::vector<const SppObservation*> obs = usable(all, opt, excluded);
+  std::vector<SatId> fde;
+  auto fail = [&](const std::string& why) {
+    SppSolution s;
+    s.reason = why;
+    s.excluded = excluded;
+    s.excluded_fde = fde;
+    return s;
+  };
+  if (obs.size() < 4) return fail("fewer than 4 satellites");
+  // the mask needs a position: a first fit without it, then drop low satellites and refit
+  SppOptions no_mask = opt;
+  no_mask.elevation_mask_deg = -90.0;
+  geo::Ecef start = initial;
+  {
+    const Layout l0 = make_layout(obs);
+    if (static_cast<int>(obs.size()) < l0.cols) return fail("fewer satellites than unknowns");
+    const LsResult coarse = iterate_ls(obs, l0, initial_state(l0, initial), gps_tow_s, klob, no_mask);
+    if (!coarse.ok) return fail(coarse.reason);
+    start = geo::Ecef(coarse.x.head<3>());
+    std::vector<const SppObservation*> kept;
+    for (std::size_t i = 0; i < obs.size(); ++i) {
+      if (coarse.rows[i].el_rad < deg_to_rad(opt.elevation_mask_deg)) ++excluded["spp: below elevation mask"];
+      else kept.push_back(obs[i]);
+    }
+    obs = kept;
+    if (obs.size() < 4) return fail("fewer than 4 satellites above the mask");
+  }
+  for (;;) {
+    const Layout l = make_layout(obs);
+    if (static_cast<int>(obs.size()) < l.cols) return fail("fewer satellites than unknowns");
+    const LsResult ls = iterate_ls(obs, l, initial_state(l, start), gps_tow_s, klob, no_mask);
+    if (!ls.ok) return fail(ls.reason);
+    int used = 0;
+    for (const Row& r : ls.rows) used += r.masked ? 0 : 1;
+    SppSolution s = to_solution(ls, obs, l);
+    if (!fill_dop(ls, obs, l, s) || !(s.gdop < opt.max_gdop)) return fail("singular geometry (GDOP)");
+    const int dof = used - l.cols;
+    const bool test_fails = dof >= 1 && s.chi2 > chi_square_quantile(opt.fde_false_alarm, dof);
+    if (!test_fails || static_cast<int>(fde.size()) >= opt.max_fde_exclusions || dof < 2) {
+      s.excluded = excluded;
+      s.excluded_fde = fde;
+      if (test_fails) s.reason = "residual test failed after exclusions";
+      return s;
+    }
+    const std::size_t worst = worst_satellite(ls);
+    fde.push_back(obs[worst]->sat);
+    ++excluded["spp: FDE residual test"];
+    obs.erase(obs.begin() + static_cast<std::ptrdiff_t>(worst));
+  }
+}
+
+}  // namespace pdnav::gnss

@@ -1,0 +1,187 @@
+// Rotation-vector / compass heading and APT's gyro re-orientation (Zhu/Li/Chen 2013, Sec. V-B).
+#include "pdnav/pdr/heading.h"
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+namespace pdnav::pdr {
+
+Eigen::Vector3d forward_axis(Mount mount) {
+  switch (mount) {
+    case Mount::kChestScreenOut:
+      return Eigen::Vector3d::UnitZ();
+    case Mount::kHandheld:
+      return Eigen::Vector3d::UnitY();
+    case Mount::kChestCameraOut:
+    default:
+      return -Eigen::Vector3d::UnitZ();
+  }
+}
+
+namespace {
+std::optional<double> horizontal_heading(double east, double north, double min_horizontal) {
+  if (!std::isfinite(east) || !std::isfinite(north) || std::hypot(east, north) < min_horizontal) {
+    return std::nullopt;
+  }
+  return wrap_two_pi(std::atan2(east, north));
+}
+}  // namespace
+
+std::optional<double> rotation_vector_heading_rad(const Eigen::Vector4d& quat_xyzw,
+                                                  const Eigen::Vector3d& forward_phone, double min_horizontal) {
+  if (!quat_xyzw.allFinite() || quat_xyzw.norm() < 0.5) return std::nullopt;
+  const Eigen::Quaterniond q(quat_xyzw[3], quat_xyzw[0], quat_xyzw[1], quat_xyzw[2]);
+  const Eigen::Vector3d f = q.normalized() * forward_phone.normalized();  // ENU
+  return horizontal_heading(f.x(), f.y(), min_horizontal);
+}
+
+std::optional<double> compass_heading_rad(const Eigen::Vector3d& field_phone, const Eigen::Vector3d& up_phone,
+                                          const Eigen::Vector3d& forward_phone, double min_horizontal) {
+  if (!field_phone.allFinite() || !up_phone.allFinite() || up_phone.norm() < 1e-6) return std::nullopt;
+  const Eigen::Vector3d up = up_phone.normalized();
+  const Eigen::Vector3d east_raw = field_phone.cross(up);
+  if (east_raw.norm() < 1e-6) return std::nullopt;
+  const Eigen::Vector3d east = east_raw.normalized();
+  const Eigen::Vector3d north = up.cross(east);
+  const Eigen::Vector3d f = forward_phone.normalized();
+  return horizontal_heading(f.dot(east), f.dot(north), min_horizontal);
+}
+
+GyroTurnTracker::GyroTurnTracker(const TurnOptions& options) : opt_(options) {}
+
+void GyroTurnTracker::feed(const AccelSample& s) {
+  const SampleCheck c = check_sample(s.t_ns, s.acc_mps2.allFinite(), acc_last_ns_, have_acc_last_,
+                                     opt_.gap_reset_s, accel_counters_);
+  if (c == SampleCheck::kNonFinite || c == SampleCheck::kDuplicate || c == SampleCheck::kBackwards) return;
+  if (c == SampleCheck::kGap) {
+    acc_window_.clear();
+    acc_sum_.setZero();
+  }
+  have_acc_last_ = true;
+  acc_last_ns_ = s.t_ns;
+  acc_window_.emplace_back(s.t_ns, s.acc_mps2);
+  acc_sum_ += s.acc_mps2;
+  const TimeNs horizon = s.t_ns - s_to_ns(opt_.window_s);
+  while (!acc_window_.empty() && acc_window_.front().first <= horizon) {
+    acc_sum_ -= acc_window_.front().second;
+    acc_window_.pop_front();
+  }
+  const bool window_full = acc_window_.size() >= 2 &&
+                           ns_to_s(acc_window_.back().first - acc_window_.front().first) >= 0.8 * opt_.window_s;
+  // APT: average the acceleration while walking straight to estimate gravity; hold it in turns.
+  if (window_full && (state_ == State::kStraight || !have_gravity_)) {
+    const Eigen::Vector3d mean = acc_sum_ / static_cast<double>(acc_window_.size());
+    if (mean.norm() > 0.3 * kStandardGravity_mps2) {
+      up_ = mean.normalized();
+      have_gravity_ = true;
+    }
+  }
+}
+
+void GyroTurnTracker::feed(const GyroSample& s) {
+  const SampleCheck c = check_sample(s.t_ns, s.rate_radps.allFinite(), gyro_last_ns_, have_gyro_last_,
+                                     opt_.gap_reset_s, gyro_counters_);
+  if (c == SampleCheck::kNonFinite || c == SampleCheck::kDuplicate || c == SampleCheck::kBackwards) return;
+  const bool integrate = have_gyro_last_ && c != SampleCheck::kGap && have_gravity_;
+  if (c == SampleCheck::kGap) {
+    // Heading across the gap is unknown: restart the windows (no turn spans a gap).
+    history_.clear();
+    state_ = State::kStraight;
+  }
+  if (integrate) {
+    // Trapezoidal angular displacement, projected on the vertical (APT Sec. V-B).
+    const double dt = ns_to_s(s.t_ns - gyro_last_ns_);
+    yaw_rad_ += 0.5 * (s.rate_radps + gyro_last_).dot(up_) * dt;
+  }
+  have_gyro_last_ = true;
+  gyro_last_ns_ = s.t_ns;
+  gyro_last_ = s.rate_radps;
+  if (!have_gravity_) return;
+  history_.push_back({s.t_ns, yaw_rad_});
+  trim_history(s.t_ns);
+  update_turn_state(s.t_ns);
+}
+
+void GyroTurnTracker::trim_history(TimeNs t_ns) {
+  const TimeNs keep = s_to_ns(3.0 * opt_.window_s);
+  while (!history_.empty() && history_.front().t_ns < t_ns - keep) history_.pop_front();
+}
+
+bool GyroTurnTracker::window_straight() const {
+  const TimeNs t = history_.back().t_ns;
+  const TimeNs w = s_to_ns(opt_.window_s);
+  // yaw at the start of the window: latest sample at or before t - w
+  const YawAt* start = nullptr;
+  for (auto it = history_.rbegin(); it != history_.rend(); ++it) {
+    if (it->t_ns <= t - w) {
+      start = &*it;
+      break;
+    }
+  }
+  if (!start) start = &history_.front();
+  double lo = start->yaw, hi = start->yaw;
+  for (auto it = history_.rbegin(); it != history_.rend() && it->t_ns >= start->t_ns; ++it) {
+    lo = std::min(lo, it->yaw);
+    hi = std::max(hi, it->yaw);
+  }
+  return std::abs(history_.back().yaw - start->yaw) < opt_.straight_threshold_rad &&
+         hi - lo < 2.0 * opt_.straight_threshold_rad;
+}
+
+double GyroTurnTracker::mean_yaw(TimeNs from_ns, TimeNs to_ns) const {
+  double sum = 0.0;
+  int n = 0;
+  for (const auto& h : history_) {
+    if (h.t_ns >= from_ns && h.t_ns <= to_ns) {
+      sum += h.yaw;
+      ++n;
+    }
+  }
+  if (n == 0) return history_.empty() ? yaw_rad_ : history_.front().yaw;
+  return sum / n;
+}
+
+void GyroTurnTracker::update_turn_state(TimeNs t_ns) {
+  const TimeNs w = s_to_ns(opt_.window_s);
+  const bool straight_now = window_straight();
+  switch (state_) {
+    case State::kStraight:
+      if (!straight_now) {
+        // Onset lies within the last window: the anchor is the mean yaw of the window before it.
+        const TimeNs from = std::max(t_ns - 2 * w, last_turn_end_ns_);
+        anchor_yaw_ = mean_yaw(from, std::max(from, t_ns - w));
+        turn_start_ns_ = t_ns - w;
+        state_ = State::kTurning;
+      }
+      break;
+    case State::kTurning:
+      if (straight_now) {
+        state_ = State::kSettling;
+        settle_since_ns_ = t_ns;
+      }
+      break;
+    case State::kSettling:
+      if (!straight_now) {
+        state_ = State::kTurning;
+      } else if (t_ns - settle_since_ns_ >= w) {
+        // A whole straight window after the turn: its mean yaw is the new direction.
+        const double angle = mean_yaw(t_ns - w, t_ns) - anchor_yaw_;
+        const TimeNs end_ns = settle_since_ns_;
+        if (std::abs(angle) >= opt_.report_threshold_rad) {
+          turns_.push_back(PdrTurn{end_ns, turn_start_ns_, angle});
+        }
+        last_turn_end_ns_ = end_ns;
+        state_ = State::kStraight;
+      }
+      break;
+  }
+}
+
+std::vector<PdrTurn> GyroTurnTracker::take_turns() {
+  std::vector<PdrTurn> out;
+  out.swap(turns_);
+  return out;
+}
+
+}  // namespace pdnav::pdr

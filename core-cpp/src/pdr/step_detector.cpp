@@ -1,0 +1,172 @@
+// Level-crossing step detector (APT, Zhu/Li/Chen 2013, Sec. V-A) with real-data gates.
+#include "pdnav/pdr/step_detector.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pdnav::pdr {
+
+SampleCheck check_sample(TimeNs t_ns, bool finite, TimeNs last_t_ns, bool have_last, double gap_reset_s,
+                         SampleCounters& counters) {
+  if (!finite) {
+    ++counters.non_finite;
+    return SampleCheck::kNonFinite;
+  }
+  if (have_last && t_ns == last_t_ns) {
+    ++counters.duplicate_time;
+    return SampleCheck::kDuplicate;
+  }
+  if (have_last && t_ns < last_t_ns) {
+    ++counters.backwards_time;
+    return SampleCheck::kBackwards;
+  }
+  ++counters.accepted;
+  if (have_last && ns_to_s(t_ns - last_t_ns) > gap_reset_s) {
+    ++counters.gaps;
+    return SampleCheck::kGap;
+  }
+  return SampleCheck::kOk;
+}
+
+StepDetectorOptions StepDetectorOptions::paper() {
+  StepDetectorOptions o;
+  o.lowpass_hz = 0.0;
+  o.min_step_interval_s = 0.0;
+  o.refractory_fraction = 0.0;
+  o.min_sigma_mps2 = 0.0;
+  o.min_swing_mps2 = 0.0;
+  o.bout_min_steps = 1;
+  return o;
+}
+
+StepDetector::StepDetector(const StepDetectorOptions& options) : opt_(options) {}
+
+void StepDetector::reset() {
+  have_last_ = false;
+  filter_init_ = false;
+  lp1_ = lp2_ = 0.0;
+  window_.clear();
+  sum_ = sum_sq_ = 0.0;
+  pushes_since_resum_ = 0;
+  last_defined_ = Symbol::kUndefined;
+  period_max_ = period_min_ = 0.0;
+  have_step_ = false;
+  typical_interval_s_ = 0.0;
+}
+
+double StepDetector::filter(double magnitude, double dt_s) {
+  if (opt_.lowpass_hz <= 0.0) return magnitude;
+  if (!filter_init_) {
+    lp1_ = lp2_ = magnitude;
+    filter_init_ = true;
+    return magnitude;
+  }
+  // Two cascaded first-order sections, time-aware so irregular sampling is handled.
+  const double tau = 1.0 / (2.0 * kPi * opt_.lowpass_hz);
+  const double alpha = dt_s / (tau + dt_s);
+  lp1_ += alpha * (magnitude - lp1_);
+  lp2_ += alpha * (lp1_ - lp2_);
+  return lp2_;
+}
+
+void StepDetector::push_window(TimeNs t_ns, double value) {
+  window_.push_back({t_ns, value});
+  sum_ += value;
+  sum_sq_ += value * value;
+  const TimeNs horizon = t_ns - s_to_ns(opt_.window_s);
+  while (!window_.empty() && window_.front().t_ns <= horizon) {
+    sum_ -= window_.front().value;
+    sum_sq_ -= window_.front().value * window_.front().value;
+    window_.pop_front();
+  }
+  constexpr std::int64_t kResumEvery = 4096;
+  if (++pushes_since_resum_ >= kResumEvery) {
+    pushes_since_resum_ = 0;
+    sum_ = sum_sq_ = 0.0;
+    for (const auto& w : window_) {
+      sum_ += w.value;
+      sum_sq_ += w.value * w.value;
+    }
+  }
+}
+
+StepDetector::Symbol StepDetector::quantise(double value) const {
+  const double n = static_cast<double>(window_.size());
+  if (n < 2.0) return Symbol::kUndefined;
+  const double mean = sum_ / n;
+  const double sigma = std::sqrt(std::max(0.0, sum_sq_ / n - mean * mean));
+  if (sigma < opt_.min_sigma_mps2 || sigma <= 0.0) return Symbol::kUndefined;
+  if (value > mean + opt_.k_sigma * sigma) return Symbol::kHigh;
+  if (value < mean - opt_.k_sigma * sigma) return Symbol::kLow;
+  return Symbol::kUndefined;
+}
+
+std::optional<StepCandidate> StepDetector::on_symbol(Symbol sym, TimeNs t_ns, double value) {
+  if (sym == Symbol::kUndefined) return std::nullopt;
+  if (sym == Symbol::kHigh) {
+    // Consecutive equal symbols merge; track the extreme of the current run.
+    period_max_ = (last_defined_ == Symbol::kHigh) ? std::max(period_max_, value) : value;
+    last_defined_ = Symbol::kHigh;
+    return std::nullopt;
+  }
+  const bool completes_period = (last_defined_ == Symbol::kHigh);  // "10" or "1 undefined 0"
+  const double prev_min = period_min_;
+  period_min_ = (last_defined_ == Symbol::kLow) ? std::min(period_min_, value) : value;
+  last_defined_ = Symbol::kLow;
+  if (!completes_period) return std::nullopt;
+  const double swing = period_max_ - std::min(prev_min, value);
+  const double interval = have_step_ ? ns_to_s(t_ns - last_step_ns_) : 0.0;
+  const double refractory = std::max(opt_.min_step_interval_s, opt_.refractory_fraction * typical_interval_s_);
+  if (have_step_ && interval < refractory) return std::nullopt;
+  if (swing < opt_.min_swing_mps2) return std::nullopt;
+  if (have_step_ && interval <= opt_.max_step_interval_s) {
+    // Running average of the step interval (time constant ~8 steps) for the adaptive refractory.
+    constexpr double kGain = 0.125;
+    typical_interval_s_ = typical_interval_s_ > 0.0 ? typical_interval_s_ + kGain * (interval - typical_interval_s_) : interval;
+  } else if (have_step_) {
+    typical_interval_s_ = 0.0;  // a pause: forget the cadence
+  }
+  StepCandidate c;
+  c.t_ns = t_ns;
+  c.swing_mps2 = swing;
+  c.interval_s = interval;
+  have_step_ = true;
+  last_step_ns_ = t_ns;
+  return c;
+}
+
+std::optional<StepCandidate> StepDetector::feed(const AccelSample& s) {
+  const bool finite = s.acc_mps2.allFinite();
+  const SampleCheck check = check_sample(s.t_ns, finite, last_t_ns_, have_last_, opt_.gap_reset_s, counters_);
+  if (check == SampleCheck::kNonFinite || check == SampleCheck::kDuplicate || check == SampleCheck::kBackwards) {
+    return std::nullopt;
+  }
+  if (check == SampleCheck::kGap) reset();
+  const double dt_s = have_last_ ? ns_to_s(s.t_ns - last_t_ns_) : 0.0;
+  have_last_ = true;
+  last_t_ns_ = s.t_ns;
+  const double value = filter(s.acc_mps2.norm(), dt_s);
+  push_window(s.t_ns, value);
+  return on_symbol(quantise(value), s.t_ns, value);
+}
+
+std::vector<StepCandidate> detect_steps(const std::vector<AccelSample>& samples,
+                                        const StepDetectorOptions& options, SampleCounters* counters) {
+  StepDetector detector(options);
+  BoutGate<StepCandidate> gate(options.bout_min_steps, options.max_step_interval_s);
+  std::vector<StepCandidate> steps;
+  std::int64_t gaps_seen = 0;
+  for (const auto& s : samples) {
+    const auto c = detector.feed(s);
+    if (detector.counters().gaps != gaps_seen) {  // a gap resets the bout as well
+      gaps_seen = detector.counters().gaps;
+      gate.end_bout();
+    }
+    if (!c) continue;
+    for (auto& released : gate.push(c->t_ns, *c)) steps.push_back(released);
+  }
+  if (counters) *counters = detector.counters();
+  return steps;
+}
+
+}  // namespace pdnav::pdr

@@ -1,0 +1,105 @@
+// Fast, seeded random numbers and approximations for the particle filter's inner loops.
+// Private to the terrain module. Accuracy is stated per function; tests cover them.
+#pragma once
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+namespace pdnav::terrain::detail {
+
+/// SplitMix64 (Steele, Lea, Flood 2014): expands one 64-bit seed into generator states.
+inline std::uint64_t splitmix64(std::uint64_t& x) {
+  std::uint64_t z = (x += 0x9E3779B97F4A7C15ULL);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+/// xoshiro256+ (Blackman & Vigna 2018): fast 64-bit generator for floating-point use; its
+/// weak low bits are never used alone here (uniforms take the high bits).
+class Xoshiro256Plus {
+ public:
+  explicit Xoshiro256Plus(std::uint64_t seed = 1) { reseed(seed); }
+  void reseed(std::uint64_t seed) {
+    std::uint64_t x = seed;
+    for (auto& v : s_) v = splitmix64(x);
+  }
+  std::uint64_t next() {
+    const std::uint64_t result = s_[0] + s_[3];
+    const std::uint64_t t = s_[1] << 17;
+    s_[2] ^= s_[0];
+    s_[3] ^= s_[1];
+    s_[1] ^= s_[2];
+    s_[0] ^= s_[3];
+    s_[2] ^= t;
+    s_[3] = (s_[3] << 45) | (s_[3] >> 19);
+    return result;
+  }
+  /// Uniform in [0, 1) from the top 24 bits.
+  float uniform_f() { return static_cast<float>(next() >> 40) * 0x1.0p-24f; }
+  /// Uniform in (0, 1] from the top 53 bits (never 0: safe for log).
+  double uniform_open0() { return (static_cast<double>(next() >> 11) + 1.0) * 0x1.0p-53; }
+
+ private:
+  std::uint64_t s_[4];
+};
+
+/// Standard normal approximation from one 64-bit draw: Irwin-Hall sum of four 16-bit
+/// uniforms, centred and scaled to unit variance (support +-3.46 sigma, excess kurtosis -0.3).
+/// Used for process noise only, where the truncated tails are harmless.
+inline float normal_from_bits(std::uint64_t r) {
+  const auto a = static_cast<std::uint32_t>(r & 0xFFFFu);
+  const auto b = static_cast<std::uint32_t>((r >> 16) & 0xFFFFu);
+  const auto c = static_cast<std::uint32_t>((r >> 32) & 0xFFFFu);
+  const auto d = static_cast<std::uint32_t>(r >> 48);
+  const float sum = static_cast<float>(a + b + c + d) * (1.0f / 65536.0f);  // mean 2, var 1/3
+  return (sum - 2.0f + 2.0f / 65536.0f) * 1.7320508f;
+}
+
+/// Round to nearest (ties to even) for |x| < 2^22 without a libm call (needs IEEE
+/// arithmetic: the project never builds with -ffast-math).
+inline float round_nearest(float x) {
+  constexpr float kMagic = 12582912.0f;  // 1.5 * 2^23
+  return (x + kMagic) - kMagic;
+}
+
+/// exp(x) for x <= 0 (relative error < 2e-7 for x > -87; 0 below). Cody-Waite split into
+/// 2^k * 2^f with a degree-6 polynomial for 2^f on [-0.5, 0.5].
+inline float fast_exp_neg(float x) {
+  const bool in_range = x > -87.0f;  // false for NaN too
+  const float xc = in_range ? x : -87.0f;  // branch-free: the result is selected below
+  const float t = xc * 1.44269504f;  // x / ln 2
+  const float k = round_nearest(t);
+  const float f = t - k;  // [-0.5, 0.5]
+  // 2^f Taylor/minimax coefficients (ln2^n / n!)
+  float p = 1.5403530e-4f;
+  p = p * f + 1.3333558e-3f;
+  p = p * f + 9.6181291e-3f;
+  p = p * f + 5.5504109e-2f;
+  p = p * f + 2.4022651e-1f;
+  p = p * f + 6.9314718e-1f;
+  p = p * f + 1.0f;
+  const std::int32_t bits = (static_cast<std::int32_t>(k) + 127) << 23;
+  float scale;
+  std::memcpy(&scale, &bits, sizeof scale);
+  return in_range ? p * scale : 0.0f;
+}
+
+/// sin and cos of x in [-pi, pi] through the half angle (Taylor to degree 9/10 on
+/// [-pi/2, pi/2]); absolute error < 1e-5.
+inline void fast_sincos(float x, float& s_out, float& c_out) {
+  const float h = 0.5f * x;
+  const float h2 = h * h;
+  const float s = h * (1.0f + h2 * (-1.0f / 6 + h2 * (1.0f / 120 + h2 * (-1.0f / 5040 + h2 * (1.0f / 362880)))));
+  const float c = 1.0f + h2 * (-0.5f + h2 * (1.0f / 24 + h2 * (-1.0f / 720 + h2 * (1.0f / 40320 + h2 * (-1.0f / 3628800)))));
+  s_out = 2.0f * s * c;
+  c_out = c * c - s * s;
+}
+
+/// Wrap an angle to [-pi, pi] without branches.
+inline float wrap_pi_f(float x) {
+  constexpr float two_pi = 6.28318531f;
+  return x - two_pi * round_nearest(x * (1.0f / two_pi));
+}
+
+}  // namespace pdnav::terrain::detail

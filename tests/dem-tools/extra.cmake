@@ -1,0 +1,7 @@
+# ---- terrain helper: DEM tiler + basemap tests (begin) ----
+add_test(NAME dem_tools.pdnav_dem
+  COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/dem-tools/test_pdnav_dem.py"
+          "${PDNAV_SHARED_DATA_DIR}" "${PROJECT_BINARY_DIR}/test-scratch/dem-tools-pdem")
+set_tests_properties(dem_tools.pdnav_dem PROPERTIES LABELS "dem-tools" TIMEOUT 300)
+# ---- terrain helper: DEM tiler + basemap tests (end) ----
+include(${CMAKE_CURRENT_LIST_DIR}/graph.cmake)

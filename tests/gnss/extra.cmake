@@ -1,0 +1,5 @@
+# Issue 7 bar through the CLI on the real Mountain View log (the GoogleTest
+# SolverMountainView.* checks the same numbers through the library).
+add_test(NAME gnss.cli_mountainview_bar
+  COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/gnss/check_cli_bar.py" "$<TARGET_FILE:pdnav>" "${PDNAV_SHARED_DATA_DIR}")
+set_tests_properties(gnss.cli_mountainview_bar PROPERTIES LABELS "gnss;cli" TIMEOUT 300)
