@@ -113,8 +113,10 @@ def plot_replay(args):
     engines = [r["engine"] for r in rows]
 
     fig, ax = plt.subplots(figsize=(9, 8))
-    pad = max(50.0, 0.1 * max(np.nanmax(e) - np.nanmin(e), np.nanmax(n) - np.nanmin(n)))
-    extent = (np.nanmin(e) - pad, np.nanmax(e) + pad, np.nanmin(n) - pad, np.nanmax(n) + pad)
+    all_e = np.concatenate([e, re_[np.isfinite(re_)]])
+    all_n = np.concatenate([n, rn[np.isfinite(rn)]])
+    pad = max(50.0, 0.1 * max(np.nanmax(all_e) - np.nanmin(all_e), np.nanmax(all_n) - np.nanmin(all_n)))
+    extent = (np.nanmin(all_e) - pad, np.nanmax(all_e) + pad, np.nanmin(all_n) - pad, np.nanmax(all_n) + pad)
     if args.background:
         hillshade_background(ax, args.background, lat0, lon0, extent)
     if np.isfinite(re_).any():

@@ -12,7 +12,9 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
 
+#include "pdnav/geo/wmm.h"
 #include "pdnav/io/log_writer.h"
 #include "pdnav/terrain/dem.h"
 #include "pdnav/terrain/simulator.h"
@@ -44,15 +46,27 @@ MetaSample meta(const std::string& key, const std::string& value) {
   return m;
 }
 
-/// Rotation vector of a phone held flat, top edge pointing along the (true-north) heading:
-/// a rotation about ENU up by -heading (Android azimuth = -yaw).
-RotationVectorSample rotation_for_heading(TimeNs t_ns, double heading_rad, double accuracy_rad) {
-  RotationVectorSample r;
-  r.t_ns = t_ns;
-  const double half = -0.5 * heading_rad;
-  r.quat_xyzw = Eigen::Vector4d(0.0, 0.0, std::sin(half), std::cos(half));
-  r.heading_accuracy_rad = accuracy_rad;
-  return r;
+/// Wall-clock time of a simulated session's first sample (2026-06-01T08:00Z): sets the
+/// utc_ms of every sample, so the replay's WMM declination is that of a real session.
+constexpr std::int64_t kSimSessionStartUnixMs = 1780300800000;
+
+/// Rotation vector (phone -> ENU, magnetic north) of a chest-mounted phone, top edge up,
+/// camera facing the walking direction (pdr::Mount::kChestCameraOut, the app's mount):
+/// phone -Z = forward = (sin h, cos h, 0), phone +Y = up, phone +X = forward x up.
+RotationVectorSample rotation_for_heading(TimeNs t_ns, std::int64_t utc_ms, double magnetic_heading_rad,
+                                          double accuracy_rad) {
+  const double sh = std::sin(magnetic_heading_rad), ch = std::cos(magnetic_heading_rad);
+  Eigen::Matrix3d r;  // columns: phone X, Y, Z in ENU
+  r.col(0) = Eigen::Vector3d(ch, -sh, 0.0);
+  r.col(1) = Eigen::Vector3d(0.0, 0.0, 1.0);
+  r.col(2) = Eigen::Vector3d(-sh, -ch, 0.0);
+  const Eigen::Quaterniond q(r);
+  RotationVectorSample out;
+  out.t_ns = t_ns;
+  out.utc_ms = utc_ms;
+  out.quat_xyzw = Eigen::Vector4d(q.x(), q.y(), q.z(), q.w());
+  out.heading_accuracy_rad = accuracy_rad;
+  return out;
 }
 
 /// Merge the walk's streams into one time-ordered sample list (Meta lines first).
@@ -64,20 +78,30 @@ std::vector<Sample> to_samples(const terrain::SimulatedWalk& w, const SimulateAr
   out.emplace_back(meta("UserHeightMeters", num(a.user_height_m)));
   out.emplace_back(meta("DemFile", a.dem));
   out.emplace_back(meta("DemSourceSha256", dem.info().source_sha256));
-  out.emplace_back(meta("HeadingReference", "true_north"));
+  out.emplace_back(meta("HeadingReference", "magnetic (rotation vector, chest mount, camera forward)"));
   out.emplace_back(meta("Simulator", "pdnav simulate seed " + std::to_string(a.seed)));
+  const auto utc_of = [&](TimeNs t_ns) { return kSimSessionStartUnixMs + (t_ns - w.t0_ns) / kNsPerMs; };
+  // The phone reports magnetic heading: subtract the WMM declination the replay will add back.
+  const double declination_rad = geo::magnetic_declination_rad(w.declared_start, kSimSessionStartUnixMs);
+  auto pressure = [&](std::size_t i) {
+    PressureSample p = w.pressure[i];
+    p.utc_ms = utc_of(p.t_ns);
+    return p;
+  };
   std::size_t ip = 0;
   for (std::size_t k = 0; k < w.steps.size(); ++k) {
     const PdrStep& s = w.steps[k];
-    while (ip < w.pressure.size() && w.pressure[ip].t_ns <= s.t_ns) out.emplace_back(w.pressure[ip++]);
+    while (ip < w.pressure.size() && w.pressure[ip].t_ns <= s.t_ns) out.emplace_back(pressure(ip++));
     // The heading sensor reports just before the step event.
-    out.emplace_back(rotation_for_heading(s.t_ns - kNsPerMs, s.heading_rad, s.heading_sigma_rad));
+    const TimeNs t_rv = s.t_ns - kNsPerMs;
+    out.emplace_back(rotation_for_heading(t_rv, utc_of(t_rv), s.heading_rad - declination_rad, s.heading_sigma_rad));
     StepDetectorSample sd;
     sd.t_ns = s.t_ns;
+    sd.utc_ms = utc_of(s.t_ns);
     out.emplace_back(sd);
     out.emplace_back(w.truth[k]);
   }
-  while (ip < w.pressure.size()) out.emplace_back(w.pressure[ip++]);
+  while (ip < w.pressure.size()) out.emplace_back(pressure(ip++));
   return out;
 }
 
@@ -100,6 +124,9 @@ int run_simulate(const SimulateArgs& a) {
   terrain::WalkSimOptions opt;
   opt.min_length_m = a.min_length_m;
   opt.max_length_m = a.max_length_m;
+  // The walker's mean step follows the APT height model the replay's PDR uses (l = 0.415 h,
+  // Zhu et al. Sec. V-A); each walk still deviates from it by step_length_walk_sd_m.
+  opt.step_length_mean_m = 0.415 * a.user_height_m;
   if (!(opt.min_length_m > 0 && opt.max_length_m >= opt.min_length_m))
     throw std::invalid_argument("need 0 < --min-length <= --max-length");
   const terrain::SimulatedWalk w = terrain::simulate_walk(dem, opt, a.seed);

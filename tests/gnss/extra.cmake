@@ -3,3 +3,8 @@
 add_test(NAME gnss.cli_mountainview_bar
   COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/gnss/check_cli_bar.py" "$<TARGET_FILE:pdnav>" "${PDNAV_SHARED_DATA_DIR}")
 set_tests_properties(gnss.cli_mountainview_bar PROPERTIES LABELS "gnss;cli" TIMEOUT 300)
+
+# Broadcast ephemeris vs precise SP3 orbits (the truth check of the multi-GNSS orbit code).
+add_test(NAME gnss.cli_orbits_sp3_bar
+  COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/gnss/check_orbits_bar.py" "$<TARGET_FILE:pdnav>" "${PDNAV_SHARED_DATA_DIR}")
+set_tests_properties(gnss.cli_orbits_sp3_bar PROPERTIES LABELS "gnss;cli" TIMEOUT 120)

@@ -9,19 +9,6 @@
 namespace pdnav::io {
 namespace {
 
-/// Collects the canonical column names of a line type.
-struct NameCollector {
-  std::vector<std::string> names;
-  template <class T> void add(std::string_view n, T&) { names.emplace_back(n); }
-  void elapsed(std::string_view n, TimeNs& x) { add(n, x); }
-  void i64(std::string_view n, std::int64_t& x) { add(n, x); }
-  void i32(std::string_view n, int& x) { add(n, x); }
-  void f64(std::string_view n, double& x) { add(n, x); }
-  void hpa(std::string_view n, double& x) { add(n, x); }
-  void flag(std::string_view n, bool& x) { add(n, x); }
-  void text(std::string_view n, std::string& x) { add(n, x); }
-  void bytes(std::string_view n, std::vector<std::uint8_t>& x) { add(n, x); }
-};
 
 /// Flattens a sample into comparable values (NaN canonicalised).
 struct Flattener {
@@ -64,7 +51,7 @@ std::vector<std::string_view> all_names(std::index_sequence<I...>) {
 template <std::size_t I> bool columns_if(std::string_view type, std::vector<std::string>& out) {
   using S = std::variant_alternative_t<I, Sample>;
   if (detail::LineTraits<S>::name != type) return false;
-  NameCollector c;
+  detail::NameCollector c;
   c.names.emplace_back(type);
   S s;
   detail::visit_fields(s, c);

@@ -101,23 +101,12 @@ struct Schema {
   std::vector<int> slot_col;    // canonical slot -> header column, -1 when absent
 };
 
-struct NameCollector {
-  std::vector<std::string> names;  // lower case
-  template <class T> void add(std::string_view n, T&) { names.push_back(lower(n)); }
-  void elapsed(std::string_view n, TimeNs& x) { add(n, x); }
-  void i64(std::string_view n, std::int64_t& x) { add(n, x); }
-  void i32(std::string_view n, int& x) { add(n, x); }
-  void f64(std::string_view n, double& x) { add(n, x); }
-  void hpa(std::string_view n, double& x) { add(n, x); }
-  void flag(std::string_view n, bool& x) { add(n, x); }
-  void text(std::string_view n, std::string& x) { add(n, x); }
-  void bytes(std::string_view n, std::vector<std::uint8_t>& x) { add(n, x); }
-};
 
 template <class S> std::vector<std::string> canonical_names() {
   NameCollector c;
   S s;
   visit_fields(s, c);
+  for (std::string& n : c.names) n = lower(n);  // header matching is case-insensitive
   return std::move(c.names);
 }
 

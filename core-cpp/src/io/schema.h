@@ -6,8 +6,10 @@
 //   v.flag(name, bool&)  v.text(name, std::string&)  v.bytes(name, std::vector<uint8_t>&)
 #pragma once
 #include <cstddef>
+#include <string>
 #include <string_view>
 #include <variant>
+#include <vector>
 
 #include "pdnav/geo/samples.h"
 
@@ -204,5 +206,19 @@ template <class V> void visit_fields(MetaSample& s, V& v) {
   v.text("Key", s.key);
   v.text("Value", s.value);
 }
+
+/// Collects the canonical column names of a line type, in schema order.
+struct NameCollector {
+  std::vector<std::string> names;
+  template <class T> void add(std::string_view n, T&) { names.emplace_back(n); }
+  void elapsed(std::string_view n, TimeNs& x) { add(n, x); }
+  void i64(std::string_view n, std::int64_t& x) { add(n, x); }
+  void i32(std::string_view n, int& x) { add(n, x); }
+  void f64(std::string_view n, double& x) { add(n, x); }
+  void hpa(std::string_view n, double& x) { add(n, x); }
+  void flag(std::string_view n, bool& x) { add(n, x); }
+  void text(std::string_view n, std::string& x) { add(n, x); }
+  void bytes(std::string_view n, std::vector<std::uint8_t>& x) { add(n, x); }
+};
 
 }  // namespace pdnav::io::detail
