@@ -229,7 +229,9 @@ TEST(NavigatorRobustness, HeadingFlipping180DegreesEveryStepStaysNearTheStart) {
   const auto out = nav.output(0);
   EXPECT_GT(out.steps, 500);
   for (const Estimate& e : out.engines)
-    if (e.valid()) EXPECT_LT((e.en_m - walk.truth()).norm(), 40.0) << to_string(e.engine) << ": " << e.en_m.transpose();
+    if (e.valid()) {
+      EXPECT_LT((e.en_m - walk.truth()).norm(), 40.0) << to_string(e.engine) << ": " << e.en_m.transpose();
+    }
 }
 
 TEST(NavigatorRobustness, DemVoidEverywhereIsAClearErrorOrDeadReckoning) {

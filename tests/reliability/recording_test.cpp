@@ -131,7 +131,9 @@ std::string file_bytes(const std::string& path) {
 /// Returns the number of samples found.
 std::int64_t check_log(const std::string& path, const ChildReport& r) {
   const std::string bytes = file_bytes(path);
-  if (!bytes.empty()) EXPECT_EQ(bytes.back(), '\n') << path << ": torn last line";
+  if (!bytes.empty()) {
+    EXPECT_EQ(bytes.back(), '\n') << path << ": torn last line";
+  }
   if (bytes.empty()) {
     EXPECT_FALSE(r.have_written) << path << ": empty although samples were reported written";
     return 0;

@@ -16,7 +16,7 @@ void DeadReckoning::initialize(const geo::Geodetic& start, double sigma_m, TimeN
 
 void DeadReckoning::feed(const PdrStep& step) {
   if (!initialized_ || !std::isfinite(step.length_m) || !std::isfinite(step.heading_rad)) return;
-  const double dt = std::max(0.0, ns_to_s(step.t_ns - t_ns_));
+  const double dt = std::max(0.0, ns_to_s(step.t_ns) - ns_to_s(t_ns_));  // no int64 overflow on wild times
   t_ns_ = step.t_ns;
   const double l = step.length_m, h = step.heading_rad + x_(2);
   const double s = std::sin(h), c = std::cos(h);

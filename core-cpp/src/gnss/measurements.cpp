@@ -172,7 +172,12 @@ bool receive_gps_time(const GnssRawSample& r, GpsTime& out) {
                         (std::isfinite(r.bias_nanos) ? r.bias_nanos : 0.0);
   if (std::fabs(offset) > 1e9) return false;
   const double whole = std::floor(offset);
-  out.ns = r.time_nanos - r.full_bias_nanos + static_cast<std::int64_t>(whole);
+  // Overflow-checked: arbitrary (fuzzed or corrupt) clock fields must not wrap.
+  std::int64_t ns = 0;
+  if (__builtin_sub_overflow(r.time_nanos, r.full_bias_nanos, &ns) ||
+      __builtin_add_overflow(ns, static_cast<std::int64_t>(whole), &ns))
+    return false;
+  out.ns = ns;
   out.frac_ns = offset - whole;
   return out.ns > 0;
 }
