@@ -43,6 +43,10 @@ struct has_utc : std::false_type {};
 template <typename T>
 struct has_utc<T, std::void_t<decltype(std::declval<T>().utc_ms)>> : std::true_type {};
 
+/// elapsedRealtimeNanos is >= 0 and far below 2^62 (146 years); outside that range a time is
+/// corrupt, and admitting it would let time differences downstream overflow int64.
+bool time_in_range(TimeNs t) { return t >= 0 && t <= (TimeNs{1} << 62); }
+
 bool wants(EngineMode mode, EngineMode engine) { return mode == EngineMode::kAuto || mode == engine; }
 }  // namespace
 
@@ -100,7 +104,7 @@ struct Navigator::Impl {
   void start(double lat_deg, double lon_deg, double sigma_m, TimeNs t_ns) {
     constexpr double kMaxStartSigmaM = 100e3;  // a start "somewhere in this country" is not a start
     if (!std::isfinite(lat_deg) || !std::isfinite(lon_deg) || std::abs(lat_deg) > 90.0 || std::abs(lon_deg) > 180.0 ||
-        !(sigma_m > 0.0) || !(sigma_m <= kMaxStartSigmaM)) {
+        !(sigma_m > 0.0) || !(sigma_m <= kMaxStartSigmaM) || !time_in_range(t_ns)) {
       count("invalid start position");
       return;
     }
@@ -173,6 +177,10 @@ struct Navigator::Impl {
 
   bool in_order(const Sample& s) {
     const TimeNs t = sample_time_ns(s);
+    if (!time_in_range(t)) {
+      count("time outside 0..2^62 ns");
+      return false;
+    }
     TimeNs& last = last_t_by_type[s.index()];
     if (last_t_by_type.count(s.index()) && t < last) {
       count("time went backwards");

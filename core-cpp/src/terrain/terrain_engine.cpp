@@ -202,7 +202,7 @@ struct TerrainEngine::Impl {
     if (!initialized || !std::isfinite(step.length_m) || !std::isfinite(step.heading_rad) ||
         step.length_m < 0.0 || step.length_m > 5.0)
       return;
-    double dt_s = ns_to_s(step.t_ns - t_ns);
+    double dt_s = ns_to_s(step.t_ns) - ns_to_s(t_ns);  // no int64 overflow on wild times
     if (!(dt_s >= 0.0)) dt_s = 0.0;
     t_ns = step.t_ns;
     ++stats.steps;
