@@ -2,6 +2,7 @@
 // walking at realistic sensor rates (no NaN, covariance finite and positive, heap flat, step
 // count right), accelerometer rates 1..500 Hz, heading flipping by 180 degrees every step,
 // a DEM that is void everywhere, and garbage samples of every type.
+#include <cstddef>
 #include <malloc.h>
 
 #include <cmath>
@@ -27,7 +28,8 @@
 #endif
 #endif
 #ifdef PDNAV_ASAN
-#include <sanitizer/allocator_interface.h>
+// From the sanitizer runtime (GCC's libasan and clang's); GCC ships no header for it.
+extern "C" std::size_t __sanitizer_get_current_allocated_bytes();
 #endif
 
 namespace pdnav::reliability {
