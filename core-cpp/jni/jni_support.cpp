@@ -96,50 +96,55 @@ void check_batch_arrays(JNIEnv* env, std::size_t rows, const JavaBatchArrays& a)
   require_rows(env, a.bytes, "bytes", rows, kBytes);
 }
 
-CopiedBatch::CopiedBatch(JNIEnv* env, jint n, const JavaBatchArrays& a) {
+BatchStorage::BatchStorage(std::size_t rows)
+    : kinds(rows), t_ns(rows), ints(rows * kInts), doubles(rows * kDoubles), strings(rows * kStrings),
+      bytes(rows * kBytes) {}
+
+namespace {
+std::size_t checked_rows(jint n) {
   if (n < 0) throw JavaError(kIllegalArgument, "negative sample count " + std::to_string(n));
+  return static_cast<std::size_t>(n);
+}
+}  // namespace
+
+CopiedBatch::CopiedBatch(JNIEnv* env, jint n, const JavaBatchArrays& a) : store_(checked_rows(n)) {
   const auto rows = static_cast<std::size_t>(n);
   check_batch_arrays(env, rows, a);
-  kinds_.resize(rows);
-  t_ns_.resize(rows);
-  ints_.resize(rows * kInts);
-  doubles_.resize(rows * kDoubles);
-  strings_.resize(rows * kStrings);
-  bytes_.resize(rows * kBytes);
-  env->GetIntArrayRegion(a.kinds, 0, n, reinterpret_cast<jint*>(kinds_.data()));
-  env->GetLongArrayRegion(a.t_ns, 0, n, reinterpret_cast<jlong*>(t_ns_.data()));
-  env->GetLongArrayRegion(a.ints, 0, static_cast<jsize>(ints_.size()), reinterpret_cast<jlong*>(ints_.data()));
-  env->GetDoubleArrayRegion(a.doubles, 0, static_cast<jsize>(doubles_.size()), doubles_.data());
-  env->GetByteArrayRegion(a.bytes, 0, static_cast<jsize>(bytes_.size()), reinterpret_cast<jbyte*>(bytes_.data()));
+  BatchStorage& b = store_;
+  env->GetIntArrayRegion(a.kinds, 0, n, reinterpret_cast<jint*>(b.kinds.data()));
+  env->GetLongArrayRegion(a.t_ns, 0, n, reinterpret_cast<jlong*>(b.t_ns.data()));
+  env->GetLongArrayRegion(a.ints, 0, static_cast<jsize>(b.ints.size()), reinterpret_cast<jlong*>(b.ints.data()));
+  env->GetDoubleArrayRegion(a.doubles, 0, static_cast<jsize>(b.doubles.size()), b.doubles.data());
+  env->GetByteArrayRegion(a.bytes, 0, static_cast<jsize>(b.bytes.size()), reinterpret_cast<jbyte*>(b.bytes.data()));
   check_pending(env);
-  for (std::size_t i = 0; i < strings_.size(); ++i) {
+  for (std::size_t i = 0; i < b.strings.size(); ++i) {
     auto s = static_cast<jstring>(env->GetObjectArrayElement(a.strings, static_cast<jsize>(i)));
     check_pending(env);
     if (s != nullptr) {  // null = empty text field
-      strings_[i] = to_string(env, s, "strings");
+      b.strings[i] = to_string(env, s, "strings");
       env->DeleteLocalRef(s);
     }
   }
-  view_ = BatchView{rows, kinds_.data(), t_ns_.data(), ints_.data(), doubles_.data(), strings_.data(), bytes_.data()};
+  view_ = BatchView{rows, b.kinds.data(), b.t_ns.data(), b.ints.data(), b.doubles.data(), b.strings.data(), b.bytes.data()};
 }
 
-OutBatch::OutBatch(std::size_t capacity)
-    : kinds_(capacity), t_ns_(capacity), ints_(capacity * kInts), doubles_(capacity * kDoubles),
-      strings_(capacity * kStrings), bytes_(capacity * kBytes) {
-  out_ = BatchOut{capacity, kinds_.data(), t_ns_.data(), ints_.data(), doubles_.data(), strings_.data(), bytes_.data()};
+OutBatch::OutBatch(std::size_t capacity) : store_(capacity) {
+  BatchStorage& b = store_;
+  out_ = BatchOut{capacity, b.kinds.data(), b.t_ns.data(), b.ints.data(), b.doubles.data(), b.strings.data(), b.bytes.data()};
 }
 
 void OutBatch::copy_to(JNIEnv* env, std::size_t n, const JavaBatchArrays& a) const {
   check_batch_arrays(env, n, a);
   const auto jn = static_cast<jsize>(n);
-  env->SetIntArrayRegion(a.kinds, 0, jn, reinterpret_cast<const jint*>(kinds_.data()));
-  env->SetLongArrayRegion(a.t_ns, 0, jn, reinterpret_cast<const jlong*>(t_ns_.data()));
-  env->SetLongArrayRegion(a.ints, 0, static_cast<jsize>(n * kInts), reinterpret_cast<const jlong*>(ints_.data()));
-  env->SetDoubleArrayRegion(a.doubles, 0, static_cast<jsize>(n * kDoubles), doubles_.data());
-  env->SetByteArrayRegion(a.bytes, 0, static_cast<jsize>(n * kBytes), reinterpret_cast<const jbyte*>(bytes_.data()));
+  const BatchStorage& b = store_;
+  env->SetIntArrayRegion(a.kinds, 0, jn, reinterpret_cast<const jint*>(b.kinds.data()));
+  env->SetLongArrayRegion(a.t_ns, 0, jn, reinterpret_cast<const jlong*>(b.t_ns.data()));
+  env->SetLongArrayRegion(a.ints, 0, static_cast<jsize>(n * kInts), reinterpret_cast<const jlong*>(b.ints.data()));
+  env->SetDoubleArrayRegion(a.doubles, 0, static_cast<jsize>(n * kDoubles), b.doubles.data());
+  env->SetByteArrayRegion(a.bytes, 0, static_cast<jsize>(n * kBytes), reinterpret_cast<const jbyte*>(b.bytes.data()));
   check_pending(env);
   for (std::size_t i = 0; i < n * kStrings; ++i) {
-    jstring s = env->NewStringUTF(strings_[i].c_str());
+    jstring s = env->NewStringUTF(b.strings[i].c_str());
     check_pending(env);
     env->SetObjectArrayElement(a.strings, static_cast<jsize>(i), s);
     check_pending(env);

@@ -82,6 +82,17 @@ struct JavaBatchArrays {
   jbyteArray bytes;
 };
 
+/// The fixed-width columns of `rows` batch rows (sample_codec.h layout).
+struct BatchStorage {
+  explicit BatchStorage(std::size_t rows);
+  std::vector<std::int32_t> kinds;
+  std::vector<std::int64_t> t_ns;
+  std::vector<std::int64_t> ints;
+  std::vector<double> doubles;
+  std::vector<std::string> strings;
+  std::vector<std::int8_t> bytes;
+};
+
 /// n rows copied out of Java arrays (validated: non-null, long enough).
 class CopiedBatch {
  public:
@@ -89,12 +100,7 @@ class CopiedBatch {
   const BatchView& view() const { return view_; }
 
  private:
-  std::vector<std::int32_t> kinds_;
-  std::vector<std::int64_t> t_ns_;
-  std::vector<std::int64_t> ints_;
-  std::vector<double> doubles_;
-  std::vector<std::string> strings_;
-  std::vector<std::int8_t> bytes_;
+  BatchStorage store_;
   BatchView view_;
 };
 
@@ -107,12 +113,7 @@ class OutBatch {
   void copy_to(JNIEnv* env, std::size_t n, const JavaBatchArrays& a) const;
 
  private:
-  std::vector<std::int32_t> kinds_;
-  std::vector<std::int64_t> t_ns_;
-  std::vector<std::int64_t> ints_;
-  std::vector<double> doubles_;
-  std::vector<std::string> strings_;
-  std::vector<std::int8_t> bytes_;
+  BatchStorage store_;
   BatchOut out_;
 };
 
