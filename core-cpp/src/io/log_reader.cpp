@@ -102,17 +102,21 @@ struct Schema {
 };
 
 
-template <class S> std::vector<std::string> canonical_names() {
-  NameCollector c;
-  S s;
-  visit_fields(s, c);
-  for (std::string& n : c.names) n = lower(n);  // header matching is case-insensitive
-  return std::move(c.names);
+/// Lower-case field names of line type S in writer order; an immutable table made once.
+template <class S> const std::vector<std::string>& canonical_names() {
+  static const std::vector<std::string> kNames = [] {
+    NameCollector c;
+    S s;
+    visit_fields(s, c);
+    for (std::string& n : c.names) n = lower(n);  // header matching is case-insensitive
+    return std::move(c.names);
+  }();
+  return kNames;
 }
 
 /// Builds the schema of line type S from header column names (type token first).
 template <class S> Schema make_schema(const std::vector<std::string>& header) {
-  const std::vector<std::string> canon = canonical_names<S>();
+  const std::vector<std::string>& canon = canonical_names<S>();
   Schema sc;
   sc.n_cols = static_cast<int>(header.size());
   sc.slot_col.assign(canon.size(), -1);
