@@ -65,6 +65,28 @@ TEST(EngineRobustness, ClockDiscontinuityResetsTdcpAndKeepsAccuracy) {
   EXPECT_LE(a.tdcp_rms_enu_m.maxCoeff(), 0.03);
 }
 
+TEST(EngineRobustness, FullBiasJumpingAcrossTheInt64RangeIsNotLinked) {
+  // Fuzz finding (fuzz_navigator, 2026-11-23): consecutive epochs with FullBiasNanos of
+  // -1.16e18 and +8.39e18 overflowed the int64 difference (UBSan in the asan/fuzz builds).
+  // The epochs must simply not be linked (no TDCP / smoothing across them), never wrap.
+  auto rows = read_raw();
+  std::vector<std::int64_t> epochs;
+  for (const auto& r : rows)
+    if (epochs.empty() || r.time_nanos != epochs.back()) epochs.push_back(r.time_nanos);
+  ASSERT_GT(epochs.size(), 30u);
+  for (auto& r : rows) {
+    if (r.time_nanos == epochs[10]) r.full_bias_nanos = -1155938064663285906;
+    if (r.time_nanos == epochs[11]) r.full_bias_nanos = 8387194961890077011;
+  }
+  GnssEngine engine(GnssOptions{}, nav(), 1);
+  for (const auto& r : rows) engine.feed(r);
+  engine.flush();
+  const auto sols = engine.take_solutions();
+  expect_finite(sols);
+  EXPECT_GE(engine.exclusions().at("epoch: gap or time going backwards (no TDCP)"), 1);
+  EXPECT_LE(evaluate_static(sols, kTruth).kf_rms_h_m, 2.5);
+}
+
 TEST(EngineRobustness, MalformedValuesAreCountedNeverNaN) {
   auto rows = read_raw();
   const double inf = std::numeric_limits<double>::infinity();

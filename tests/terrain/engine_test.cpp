@@ -5,6 +5,7 @@
 #include <memory>
 #include <vector>
 
+#include <Eigen/Core>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -92,7 +93,10 @@ struct StraightWalk {
     const DemSample h = dem->at_local(e, n);
     PressureSample p;
     p.t_ns = t - kNsPerMs;
-    p.pressure_pa = geo::baro_pressure_pa(h.valid() ? h.elevation_m : 1500.0, 101325.0, 0.0) + pressure_offset_pa;
+    // +-0.5 Pa of sensor noise (~4 cm): a real barometer never repeats one value for long
+    const double noise_pa = (t / (550 * kNsPerMs)) % 2 == 0 ? 0.5 : -0.5;
+    p.pressure_pa = geo::baro_pressure_pa(h.valid() ? h.elevation_m : 1500.0, 101325.0, 0.0) + pressure_offset_pa +
+                    noise_pa;
     pf.feed(p);
     PdrStep s;
     s.t_ns = t;
@@ -121,9 +125,11 @@ TEST(TerrainEngine, WalkingOffTheTileStaysFiniteAndSaysSo) {
 }
 
 TEST(TerrainEngine, ImpossibleBarometerTriggersRecoveryWithoutNaN) {
-  StraightWalk walk(hills_dem(), TerrainOptions::srtm_tuned());
+  TerrainOptions o = TerrainOptions::srtm_tuned();
+  o.baro_jump_m = 0.0;  // a sudden step would be compensated as a sensor step (test below)
+  StraightWalk walk(hills_dem(), o);
   for (int k = 0; k < 100; ++k) walk.step(0.3);
-  // 2 kPa lower = ~170 m higher than any particle can explain.
+  // 2 kPa lower = ~190 m higher than any particle can explain.
   for (int k = 0; k < 100; ++k) walk.step(0.3, -2000.0);
   const Estimate est = walk.pf.estimate();
   expect_finite(est);
@@ -135,11 +141,67 @@ TEST(TerrainEngine, WeightUnderflowIsCountedAndRecovered) {
   TerrainOptions o = TerrainOptions::srtm_tuned();
   o.residual_monitor = false;
   o.measurement_var_m2 = 0.01;  // every particle's likelihood underflows for a 200 m error
+  o.baro_jump_m = 0.0;          // and the step is not compensated
   StraightWalk walk(hills_dem(), o);
   for (int k = 0; k < 60; ++k) walk.step(1.0);  // the first pressure sample sets the reference
   for (int k = 0; k < 60; ++k) walk.step(1.0, -2500.0);
   expect_finite(walk.pf.estimate());
   EXPECT_GT(walk.pf.stats().weight_underflows, 0);
+}
+
+TEST(TerrainEngine, SensorStepIsMeasuredAndCompensated) {
+  // The barometer jumps by -2 kPa (~190 m) and stays there: a sensor step, not a climb. With the
+  // default compensation it is measured and subtracted; tracking goes on without a recovery.
+  StraightWalk walk(hills_dem(), TerrainOptions::srtm_tuned());
+  for (int k = 0; k < 100; ++k) walk.step(0.3);
+  for (int k = 0; k < 300; ++k) walk.step(0.3, -2000.0);
+  const Estimate est = walk.pf.estimate();
+  EXPECT_EQ(walk.pf.stats().baro_jumps, 1);
+  // 2 kPa at ~1.4 km: 2000 / (rho g) with rho 1.05-1.1 kg/m^3 = 185-195 m
+  EXPECT_NEAR(walk.pf.stats().baro_jump_offset_m, 190.0, 15.0);
+  EXPECT_EQ(walk.pf.stats().recoveries, 0);
+  EXPECT_EQ(est.status, EstimateStatus::kOk) << est.reason;
+  EXPECT_THAT(est.reason, ::testing::HasSubstr("1 barometer step(s) compensated"));
+  EXPECT_LT((est.en_m - Eigen::Vector2d(walk.e, walk.n)).norm(), 30.0);
+}
+
+TEST(TerrainEngine, RaoBlackwellisedBiasFollowsASlowBaroDrift) {
+  // After 100 consistent steps the barometer drifts to read 8 m high (0.04 m per step, no step
+  // detected), then stays: the per-particle Kalman means must converge on +8 m.
+  for (bool rb : {true, false}) {
+    TerrainOptions o = TerrainOptions::srtm_tuned();
+    o.rao_blackwell_baro_bias = rb;
+    StraightWalk walk(hills_dem(), o);
+    for (int k = 0; k < 100; ++k) walk.step(0.3);
+    const double pa_per_m = -12.0;  // ~ -12 Pa per metre at 1.2-1.5 km
+    for (int k = 0; k < 200; ++k) walk.step(0.3, pa_per_m * 0.04 * k);
+    for (int k = 0; k < 300; ++k) walk.step(0.3, pa_per_m * 8.0);
+    EXPECT_NEAR(walk.pf.bias_estimate().y(), 8.0, 2.5) << (rb ? "rao-blackwellised" : "sampled");
+    EXPECT_LT((walk.pf.estimate().en_m - Eigen::Vector2d(walk.e, walk.n)).norm(), 40.0)
+        << (rb ? "rao-blackwellised" : "sampled");  // measured: 32 m sampled
+  }
+}
+
+TEST(TerrainEngine, SegmentMeanElevationRemovesTheSlopeLag) {
+  // Up a uniform 30 % slope with the barometer averaged over 20 m between updates: compared
+  // with the end point's DEM elevation the average lags ~3 m; the segment mean does not. The
+  // filter's own prediction of the elevation now, h(north estimate) + bias, shows it.
+  auto plane = std::make_shared<const Dem>(test::synthetic_dem(201, 201, 30.0, [](double, double n) {
+    return 1000.0 + 0.3 * n;
+  }));
+  double lag_m[2] = {0.0, 0.0};
+  for (bool segment : {true, false}) {
+    TerrainOptions o = TerrainOptions::srtm_tuned();
+    o.update_distance_m = 20.0;
+    o.segment_mean_elevation = segment;
+    o.particles = 2000;
+    StraightWalk walk(plane, o);
+    for (int k = 0; k < 1000; ++k) walk.step(0.0);  // 700 m north, 210 m up
+    const double predicted = 0.3 * walk.pf.estimate().en_m.y() + walk.pf.bias_estimate().y();
+    lag_m[segment ? 0 : 1] = predicted - 0.3 * walk.n;
+  }
+  EXPECT_NEAR(lag_m[0], 0.0, 1.0) << "segment mean";
+  EXPECT_LT(lag_m[1], -2.0) << "end point (paper)";
 }
 
 TEST(TerrainEngine, ResidualMonitorFlagsAnInconsistentBarometer) {

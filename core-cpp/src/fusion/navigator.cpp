@@ -74,6 +74,11 @@ struct Navigator::Impl {
       auto dem = std::make_shared<const terrain::Dem>(terrain::Dem::load(cfg.dem_path));
       terrain::TerrainOptions topt = terrain::TerrainOptions::preset(cfg.terrain_preset);
       topt.particles = std::max(1, cfg.particles);
+      // The step-length model's stated 1-sigma (APT height model: 10 %) is mostly a per-walk
+      // scale error (the user's stride vs 0.415 h): a preset with a scale state must cover it.
+      // (The paper's four-state presets keep their per-step sigma_l only.)
+      if (topt.step_scale_sigma > 0.0)
+        topt.step_scale_sigma = std::max(topt.step_scale_sigma, pdr_options(cfg).length.sigma_fraction);
       terrain = std::make_unique<terrain::TerrainEngine>(topt, dem, seed);
     }
     if (!cfg.graph_path.empty() && wants(cfg.mode, EngineMode::kRoute)) {

@@ -92,12 +92,15 @@ struct GnssEngine::Impl {
     MeasurementEpoch ep;
     if (!build_epoch(rows, opt.measurements, ep, excluded)) { count("epoch: no usable measurement"); return; }
     handle_clock_jump(ep);
-    const double dt = has_prev ? static_cast<double>(ep.rx.ns - prev_rx.ns) * 1e-9 : 0.0;
-    if (has_prev && (!(dt > 0.0) || dt > opt.max_epoch_gap_s)) {
+    std::int64_t d_rx_ns = 0, d_full_bias_ns = 0;  // exact int64 differences; overflow = no link
+    const bool linked = has_prev && !__builtin_sub_overflow(ep.rx.ns, prev_rx.ns, &d_rx_ns) &&
+                        !__builtin_sub_overflow(ep.full_bias_nanos, prev_full_bias_nanos, &d_full_bias_ns);
+    const double dt = linked ? static_cast<double>(d_rx_ns) * 1e-9 : 0.0;
+    if (has_prev && (!linked || !(dt > 0.0) || dt > opt.max_epoch_gap_s)) {
       count("epoch: gap or time going backwards (no TDCP)");
       has_prev = false;
     }
-    const double d_bias_ns = static_cast<double>(ep.full_bias_nanos - prev_full_bias_nanos) + (ep.bias_nanos - prev_bias_nanos);
+    const double d_bias_ns = has_prev ? static_cast<double>(d_full_bias_ns) + (ep.bias_nanos - prev_bias_nanos) : 0.0;
     smoother.begin_epoch(has_prev ? dt : 0.0, d_bias_ns * 1e-9 * kSpeedOfLight_mps);
     std::vector<SppObservation> spp_obs;
     std::vector<CarrierObservation> car_obs;

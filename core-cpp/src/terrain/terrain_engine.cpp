@@ -26,8 +26,10 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// Particle state as structure of arrays.
 struct Particles {
   std::vector<float> e, n, bh, bb, sc;  // sc: step-length scale error (beyond the paper)
+  std::vector<float> h0;  // DEM elevation at the last update (segment_mean_elevation; NaN = none)
   void resize(std::size_t count) {
     sc.assign(count, 0.0f);
+    h0.assign(count, std::numeric_limits<float>::quiet_NaN());
     e.assign(count, 0.0f);
     n.assign(count, 0.0f);
     bh.assign(count, 0.0f);
@@ -39,6 +41,7 @@ struct Particles {
     bh[dst_i] = src.bh[src_i];
     bb[dst_i] = src.bb[src_i];
     sc[dst_i] = src.sc[src_i];
+    h0[dst_i] = src.h0[src_i];
   }
 };
 
@@ -99,6 +102,8 @@ TerrainOptions TerrainOptions::srtm_tuned() {
   o.update_distance_m = 10.0;
   o.step_scale_sigma = 0.03;
   o.roughening_k = 0.2;
+  o.segment_mean_elevation = true;
+  o.rao_blackwell_baro_bias = true;
   return o;
 }
 
@@ -127,6 +132,8 @@ struct TerrainEngine::Impl {
   double baro_sum_m = 0.0;
   int baro_count = 0;
   double walked_since_update_m = 0.0;
+  double bias_var_m2 = 0.0;     // Rao-Blackwellised baro bias: common Kalman variance P
+  float bias_gain = 0.0f;       //   and the gain of the current update
 
   std::vector<double> nis_window;
   std::size_t nis_next = 0;
@@ -166,8 +173,9 @@ struct TerrainEngine::Impl {
       p.e[i] = static_cast<float>(en.x()) + s * normal();
       p.n[i] = static_cast<float>(en.y()) + s * normal();
       p.bh[i] = hs * normal();
-      p.bb[i] = bs * normal();
+      p.bb[i] = opt.rao_blackwell_baro_bias ? 0.0f : bs * normal();
       p.sc[i] = static_cast<float>(opt.step_scale_sigma) * normal();
+      p.h0[i] = dem->elevation_or_nan(p.e[i], p.n[i]);
       w[i] = 1.0f;
     }
     w_sum = sum_sq = static_cast<double>(count);
@@ -176,6 +184,10 @@ struct TerrainEngine::Impl {
     baro_sum_m = 0.0;
     baro_count = 0;
     walked_since_update_m = 0.0;
+    last_pa = last_h_m = kNaN;
+    stats.baro_jump_offset_m = 0.0;
+    stats.baro_stuck = false;
+    bias_var_m2 = opt.baro_bias_sigma_m * opt.baro_bias_sigma_m;
     nis_filled = nis_next = 0;
     recovering_until_ns = std::numeric_limits<TimeNs>::min();
     alarm.clear();
@@ -190,12 +202,59 @@ struct TerrainEngine::Impl {
     }
   }
 
+  // Barometer integrity state (feed_pressure).
+  double last_pa = kNaN;        // last sample (stuck check)
+  TimeNs same_since_ns = 0;     //   first time it was seen
+  double last_h_m = kNaN;       // last accepted raw altitude (jump check) and its time
+  TimeNs last_h_ns = 0;
+
   void feed_pressure(const PressureSample& s) {
     if (!initialized || !baro_usable) return;
-    const double h = baro.update(s.pressure_pa);
+    const double pa = s.pressure_pa;
+    if (!std::isfinite(pa) || pa < 25e3 || pa > 115e3) {  // outside any surface pressure
+      ++stats.baro_rejected;
+      return;
+    }
+    if (stuck_check(pa, s.t_ns)) return;
+    const double h = baro.update(pa);
     if (!std::isfinite(h)) return;
-    baro_sum_m += h;
+    jump_check(h, s.t_ns);
+    baro_sum_m += h - stats.baro_jump_offset_m;
     ++baro_count;
+  }
+
+  /// True while the sensor repeats one exact value for baro_stuck_s or longer.
+  bool stuck_check(double pa, TimeNs t) {
+    if (pa != last_pa) {
+      last_pa = pa;
+      same_since_ns = t;
+      stats.baro_stuck = false;
+      return false;
+    }
+    if (opt.baro_stuck_s > 0.0 && ns_to_s(t) - ns_to_s(same_since_ns) >= opt.baro_stuck_s && !stats.baro_stuck) {
+      stats.baro_stuck = true;
+      ++stats.baro_stuck_events;
+      baro_sum_m = 0.0;  // the average so far holds stuck samples too
+      baro_count = 0;
+    }
+    return stats.baro_stuck;
+  }
+
+  /// A step between consecutive samples that no walk can explain is a sensor step: measure it
+  /// and drop the average taken so far (it straddles the step).
+  void jump_check(double h, TimeNs t) {
+    const double dt_s = ns_to_s(t) - ns_to_s(last_h_ns);
+    const double dh = h - last_h_m;
+    const bool jump = opt.baro_jump_m > 0.0 && std::isfinite(dh) && dt_s >= 0.0 &&
+                      std::abs(dh) > opt.baro_jump_m + opt.baro_max_vertical_speed_mps * dt_s;
+    if (jump) {
+      ++stats.baro_jumps;
+      stats.baro_jump_offset_m += dh;
+      baro_sum_m = 0.0;
+      baro_count = 0;
+    }
+    last_h_m = h;
+    last_h_ns = t;
   }
 
   void feed_step(const PdrStep& step) {
@@ -233,6 +292,11 @@ struct TerrainEngine::Impl {
     float phi_h, q_h, phi_b, q_b;
     fogm(opt.heading_bias_sigma_rad, opt.heading_bias_tau_s, dt_s, phi_h, q_h);
     fogm(opt.baro_bias_sigma_m, opt.baro_bias_tau_s, dt_s, phi_b, q_b);
+    const bool rb = opt.rao_blackwell_baro_bias;
+    if (rb) {  // Kalman time update of the common variance; the means only fade
+      bias_var_m2 = static_cast<double>(phi_b) * phi_b * bias_var_m2 + static_cast<double>(q_b) * q_b;
+      q_b = 0.0f;
+    }
     q_h *= static_cast<float>(gain);
     const auto len = static_cast<float>(step.length_m);
     const auto dl_span = static_cast<float>(2.0 * opt.step_length_sigma_m * gain);
@@ -240,7 +304,8 @@ struct TerrainEngine::Impl {
     const auto c_th = static_cast<float>(std::cos(step.heading_rad));
     const bool measure = std::isfinite(z);
     const auto zf = static_cast<float>(z);
-    const auto inv_2r = static_cast<float>(0.5 / opt.measurement_var_m2);
+    const double innov_var = opt.measurement_var_m2 + (rb ? bias_var_m2 : 0.0);  // Eq. 5-7 (+ P)
+    const auto inv_2r = static_cast<float>(0.5 / innov_var);
     const auto no_info_ll = static_cast<float>(-0.5 * opt.no_info_sigmas * opt.no_info_sigmas);
     const auto renorm = static_cast<float>(static_cast<double>(count) / w_sum);  // keeps mean weight ~1
     const Dem& d = *dem;
@@ -249,6 +314,8 @@ struct TerrainEngine::Impl {
     float* pbh = p.bh.data();
     float* pbb = p.bb.data();
     const float* psc = p.sc.data();
+    float* ph0 = p.h0.data();
+    const bool segment = opt.segment_mean_elevation;
     float* pr = resid.data();
     for (std::size_t i = 0; i < count; ++i) {
       const std::uint64_t r1 = rng.next();
@@ -264,10 +331,33 @@ struct TerrainEngine::Impl {
       const float nb = (static_cast<float>((r2 & 0xFFFFu) + ((r2 >> 16) & 0xFFFFu) + ((r2 >> 32) & 0xFFFFu)) *
                             (1.0f / 65536.0f) - 1.5f) * 2.0f;
       pbb[i] = phi_b * pbb[i] + q_b * nb;
-      if (measure) pr[i] = zf - (d.elevation_or_nan(pe[i], pn[i]) + pbb[i]);  // NaN = no DEM
+      if (measure) {
+        const float h = d.elevation_or_nan(pe[i], pn[i]);  // NaN = void / off the tile
+        float pred = h;
+        if (segment) {
+          pred = ph0[i] == ph0[i] ? 0.5f * (ph0[i] + h) : h;  // segment mean (trapezoid)
+          ph0[i] = h;
+        }
+        pr[i] = zf - (pred + pbb[i]);
+      }
     }
     if (!measure) return;
     weight_pass(renorm, inv_2r, no_info_ll);
+    if (rb) update_bias_means(innov_var);
+  }
+
+  /// Rao-Blackwellised baro bias: Kalman measurement update of each particle's bias mean with
+  /// its own residual (voids / off the tile: no update) and of the common variance.
+  void update_bias_means(double innov_var) {
+    const double k = bias_var_m2 / innov_var;
+    const auto kf = static_cast<float>(k);
+    float* pbb = p.bb.data();
+    const float* pr = resid.data();
+    for (std::size_t i = 0; i < count; ++i) {
+      const float r = pr[i];
+      pbb[i] += r == r ? kf * r : 0.0f;
+    }
+    bias_var_m2 *= 1.0 - k;
   }
 
   /// Eq. 5-7 over the residuals of the propagation pass, in lanes of 8 so that the compiler can
@@ -356,7 +446,8 @@ struct TerrainEngine::Impl {
   void monitor(double s_valid, double s_r, double s_r2, float min_r2) {
     const double mean_r = s_r / s_valid;  // z - mean prediction
     const double var = std::max(0.0, s_r2 / s_valid - mean_r * mean_r);
-    const double nis = mean_r * mean_r / (var + opt.measurement_var_m2);
+    const double r_var = opt.measurement_var_m2 + (opt.rao_blackwell_baro_bias ? bias_var_m2 : 0.0);
+    const double nis = mean_r * mean_r / (var + r_var);
     stats.last_nis = nis;
     nis_window[nis_next] = nis;
     nis_next = (nis_next + 1) % nis_window.size();
@@ -366,7 +457,7 @@ struct TerrainEngine::Impl {
     stats.mean_nis = mean;
     if (!opt.residual_monitor) return;
     const double out = opt.monitor_outlier_sigmas;
-    const bool outlier = static_cast<double>(min_r2) > out * out * opt.measurement_var_m2;
+    const bool outlier = static_cast<double>(min_r2) > out * out * r_var;
     const bool drift = nis_filled == nis_window.size() && mean > opt.monitor_nis_threshold;
     if (!outlier && !drift) return;
     std::ostringstream os;
@@ -387,8 +478,10 @@ struct TerrainEngine::Impl {
       p.e[i] += rs * normal();
       p.n[i] += rs * normal();
       p.bh[i] = detail::wrap_pi_f(p.bh[i] + hs * normal());
-      p.bb[i] += bs * normal();
+      if (!opt.rao_blackwell_baro_bias) p.bb[i] += bs * normal();
+      p.h0[i] = std::numeric_limits<float>::quiet_NaN();  // moved: the segment start is unknown
     }
+    bias_var_m2 += static_cast<double>(bs) * bs;
     std::fill(w.begin(), w.end(), 1.0f);
     w_sum = sum_sq = static_cast<double>(count);
     nis_filled = nis_next = 0;
@@ -508,6 +601,11 @@ struct TerrainEngine::Impl {
       est.status = EstimateStatus::kDegraded;
       os << "; " << 100.0 * stats.off_dem_fraction << "% of the weight off the DEM or on voids";
     }
+    if (stats.baro_stuck) {
+      est.status = EstimateStatus::kDegraded;
+      os << "; barometer stuck (one value for " << opt.baro_stuck_s << "+ s): terrain updates paused";
+    }
+    if (stats.baro_jumps > 0) os << "; " << stats.baro_jumps << " barometer step(s) compensated";
     if (recovering()) {
       est.status = EstimateStatus::kDegraded;
       os << "; recovering (" << alarm << ")";
@@ -557,8 +655,9 @@ Eigen::Vector2d TerrainEngine::bias_estimate() const {
 }
 
 std::size_t TerrainEngine::bytes_per_particle() {
-  // 5 state floats x 2 buffers + 1 float weight + 1 float residual + 1 double resampling scratch
-  return 2 * 5 * sizeof(float) + 2 * sizeof(float) + sizeof(double);
+  // 6 floats (5 states + segment-start elevation) x 2 buffers + 1 float weight + 1 float
+  // residual + 1 double resampling scratch
+  return 2 * 6 * sizeof(float) + 2 * sizeof(float) + sizeof(double);
 }
 
 }  // namespace pdnav::terrain

@@ -44,6 +44,15 @@ struct TerrainOptions {
   /// Beyond the paper: a per-particle constant step-length scale error ~ N(0, sigma), a fifth
   /// state; 0 = the paper's four-state filter.
   double step_scale_sigma = 0.0;
+  /// Beyond the paper: the barometer is averaged over the walk since the last update, so compare
+  /// it with the mean DEM elevation of that segment (trapezoid of the particle's DEM elevation at
+  /// the last update and now) instead of the end point's, which lags on slopes; false = paper.
+  bool segment_mean_elevation = false;
+  /// Beyond the paper: Rao-Blackwellised baro bias. Given a particle's path the bias (Eq. 4) and
+  /// the measurement (Eq. 5) are linear-Gaussian, so each particle carries the bias mean of a
+  /// scalar Kalman filter (the variance is common to all particles) and is weighted by the
+  /// marginal likelihood N(z; h + b, P + R) instead of sampling the bias. false = paper.
+  bool rao_blackwell_baro_bias = false;
   /// Beyond the paper: roughening after resampling (Gordon et al. 1993), K; 0 = off.
   double roughening_k = 0.0;
   // --- residual monitoring (the paper mentions it without detail; docs/terrain.md) ---
@@ -54,6 +63,16 @@ struct TerrainOptions {
   double respread_sigma_m = 60.0;               // position noise added on recovery (per axis)
   double recovery_noise_gain = 2.0;             // process noise multiplier while recovering
   double recovery_duration_s = 60.0;
+  // --- barometer integrity (beyond the paper; docs/terrain.md) ---
+  /// A change between consecutive pressure samples of more than baro_jump_m + the altitude a
+  /// pedestrian (lifts included) can change at baro_max_vertical_speed_mps is a sensor step:
+  /// it is measured and subtracted from later samples, so the filter keeps using elevation
+  /// *changes*. 0 = off.
+  double baro_jump_m = 5.0;
+  double baro_max_vertical_speed_mps = 10.0;
+  /// A barometer repeating one exact value for this long is stuck (real sensors are never
+  /// that quiet): terrain updates pause until the value changes. 0 = off.
+  double baro_stuck_s = 20.0;
   /// Void / off-map particles: likelihood of a residual of this many sigmas (no information,
   /// a mild penalty), so voids neither kill nor attract particles.
   double no_info_sigmas = 2.0;
@@ -82,6 +101,11 @@ struct TerrainStats {
   double mean_nis = 0.0;                 // window mean of NIS
   double neff_fraction = 1.0;            // last Neff / N
   double off_dem_fraction = 0.0;         // weight on void / off-map cells at the last update
+  std::int64_t baro_rejected = 0;        // pressures outside 25-115 kPa or not finite
+  std::int64_t baro_jumps = 0;           // sensor steps measured and compensated
+  double baro_jump_offset_m = 0.0;       // sum of the compensated steps
+  std::int64_t baro_stuck_events = 0;    // times the barometer was found stuck
+  bool baro_stuck = false;               // stuck now: no terrain updates
 };
 
 class TerrainEngine {
