@@ -96,9 +96,9 @@ TerrainOptions TerrainOptions::srtm_preset() {
 
 TerrainOptions TerrainOptions::srtm_tuned() {
   TerrainOptions o;
-  o.baro_bias_sigma_m = 6.0;      // bias state absorbs baro drift + DEM error over ~600 s
+  o.baro_bias_sigma_m = 5.0;      // bias state absorbs baro drift + DEM error over ~600 s
   o.baro_bias_tau_s = 600.0;
-  o.measurement_var_m2 = 30.0;
+  o.measurement_var_m2 = 20.0;    // with the bias Rao-Blackwellised and no slope lag left
   o.update_distance_m = 10.0;
   o.step_scale_sigma = 0.03;
   o.roughening_k = 0.2;

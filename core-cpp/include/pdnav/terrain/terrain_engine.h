@@ -81,9 +81,10 @@ struct TerrainOptions {
   static TerrainOptions paper() { return {}; }
   /// The paper's 30 m / SRTM tuning: sigma_b 20 m, tau_b 1200 s, R 160 m^2, update every step.
   static TerrainOptions srtm_preset();
-  /// Beyond the paper, for 30-90 m DEMs (SRTM), tuned on simulated walks (docs/terrain.md):
-  /// sigma_b 6 m, tau_b 600 s, R 30 m^2, an update every 10 m walked, a step-scale state
-  /// (sigma 3 %) and roughening K = 0.2. The eval-terrain default.
+  /// Beyond the paper, for 30-90 m DEMs (SRTM), tuned on simulated walks over six areas of an
+  /// SRTM tile (docs/terrain.md): sigma_b 5 m, tau_b 600 s, R 20 m^2, an update every 10 m
+  /// walked, a step-scale state (sigma 3 %), roughening K = 0.2, the segment-mean elevation and
+  /// the Rao-Blackwellised baro bias. The eval-terrain default.
   static TerrainOptions srtm_tuned();
   /// "paper", "srtm" or "srtm-tuned"; throws std::invalid_argument.
   static TerrainOptions preset(const std::string& name);
