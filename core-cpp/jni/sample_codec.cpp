@@ -161,7 +161,7 @@ void gnss_raw_fields(Io& io, S& s) {
 template <std::size_t... I>
 Sample make_sample(std::size_t index, std::index_sequence<I...>) {
   Sample out;
-  ((index == I ? (out.template emplace<I>(), true) : false) || ...);
+  static_cast<void>(((index == I ? (out.template emplace<I>(), true) : false) || ...));
   return out;
 }
 

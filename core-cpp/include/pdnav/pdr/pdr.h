@@ -103,7 +103,6 @@ class Pdr {
   TimeNs last_rv_ns_ = 0;
   bool have_rv_ = false;
   std::optional<double> last_rv_heading_;
-  double last_rv_sigma_ = 0.0;
   TimeNs last_rv_check_ns_ = 0;
   bool have_mag_last_ = false;
   TimeNs mag_last_ns_ = 0;
