@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include <CLI/CLI.hpp>
@@ -29,7 +30,7 @@ struct ReplayArgs {
   int particles = 500;
   std::string preset = "srtm-tuned";
   std::uint64_t seed = 1;
-  double height_m = 1.75;
+  double height_m = std::numeric_limits<double>::quiet_NaN();  // NaN: the log's, else 1.75 m
   bool quiet = false;
 };
 
@@ -128,7 +129,8 @@ void register_replay(CLI::App& app) {
   c->add_option("--start", a->start, "start position LAT,LON[,SIGMA_M] (default: from the log)");
   c->add_option("--particles", a->particles, "terrain particle count")->capture_default_str();
   c->add_option("--terrain-preset", a->preset, "paper | srtm | srtm-tuned")->capture_default_str();
-  c->add_option("--height", a->height_m, "user height in metres (step length)")->capture_default_str();
+  c->add_option("--height", a->height_m,
+                 "user height in metres for the step length (default: the log's Meta UserHeightMeters, else 1.75)");
   c->add_option("--seed", a->seed, "random seed")->capture_default_str();
   c->add_flag("--quiet", a->quiet, "no progress bar");
   c->callback([a]() {

@@ -96,10 +96,13 @@ struct Navigator::Impl {
       pending_start_lat = cfg.start_lat_deg, pending_start_lon = cfg.start_lon_deg, pending_start_sigma = cfg.start_sigma_m;
   }
 
+  static pdr::StepLengthModel length_model(double height_m, bool female) {
+    return female ? pdr::StepLengthModel::apt_female(height_m) : pdr::StepLengthModel::apt_male(height_m);
+  }
+
   static pdr::PdrOptions pdr_options(const NavigatorConfig& c) {
     pdr::PdrOptions o;
-    o.length = c.user_female ? pdr::StepLengthModel::apt_female(c.user_height_m)
-                             : pdr::StepLengthModel::apt_male(c.user_height_m);
+    o.length = length_model(std::isfinite(c.user_height_m) ? c.user_height_m : kDefaultUserHeightM, c.user_female);
     o.source = pdr::StepSource::kAuto;  // Android step events while they arrive, else APT detector
     return o;
   }
@@ -138,6 +141,23 @@ struct Navigator::Impl {
     else if (m.key == "StartLongitudeDegrees" && !std::isfinite(cfg.start_lon_deg)) num(&pending_start_lon);
     else if (m.key == "StartSigmaMeters" && !std::isfinite(cfg.start_lat_deg)) num(&pending_start_sigma);
     if (!std::isfinite(pending_start_sigma)) pending_start_sigma = cfg.start_sigma_m;
+    if (m.key == "UserHeightMeters" && !std::isfinite(cfg.user_height_m)) height_from_log(m.value);
+  }
+
+  /// The recorded user height sets the step length, unless configured or steps were taken.
+  void height_from_log(const std::string& value) {
+    double h = kNaN;
+    try {
+      h = std::stod(value);
+    } catch (const std::exception&) {
+    }
+    if (!(h >= 0.5 && h <= 2.5)) {
+      count("Meta UserHeightMeters: not a height in 0.5-2.5 m");
+    } else if (steps > 0) {
+      count("Meta UserHeightMeters: after the first step (ignored)");
+    } else {
+      pdr.set_length_model(length_model(h, cfg.user_female));
+    }
   }
 
   void drain_pdr() {

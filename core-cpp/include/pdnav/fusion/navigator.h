@@ -17,6 +17,8 @@ enum class EngineMode { kAuto, kDeadReckoning, kTerrain, kRoute, kGnss };
 EngineMode engine_mode_from_string(const std::string& s);  // "auto", "dr", "terrain", "route", "gnss"; throws std::invalid_argument
 const char* to_string(EngineMode m);
 
+inline constexpr double kDefaultUserHeightM = 1.75;
+
 /// Plain configuration (what the app's settings screen and the CLI flags set).
 struct NavigatorConfig {
   EngineMode mode = EngineMode::kAuto;
@@ -25,7 +27,9 @@ struct NavigatorConfig {
   double start_lat_deg = kNaN;
   double start_lon_deg = kNaN;
   double start_sigma_m = 5.0;             // Broyles et al. 2018: 5 m initial uncertainty
-  double user_height_m = 1.75;
+  /// User height for the APT step length; NaN = the log's Meta UserHeightMeters when it comes
+  /// before the first step, else kDefaultUserHeightM.
+  double user_height_m = kNaN;
   bool user_female = false;
   std::string dem_path;                   // project DEM tile (dem-tools), empty = no terrain engine
   std::string graph_path;                 // project walkway graph (dem-tools), empty = no route engine

@@ -66,6 +66,9 @@ class Pdr {
   void feed(const StepDetectorSample& s);
   /// Position and UTC time (Unix ms) for the WMM declination; may be called again at any time.
   void set_location(const geo::Geodetic& where, std::int64_t utc_ms);
+  /// Replace the step-length model (e.g. the user's height read from a recorded session);
+  /// applies to the steps detected from now on.
+  void set_length_model(const StepLengthModel& model) { opt_.length = model; }
 
   /// Steps since the last call (time, length, TRUE-north heading, sigmas).
   std::vector<PdrStep> take_steps();
