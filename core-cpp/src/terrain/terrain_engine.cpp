@@ -133,7 +133,6 @@ struct TerrainEngine::Impl {
   int baro_count = 0;
   double walked_since_update_m = 0.0;
   double bias_var_m2 = 0.0;     // Rao-Blackwellised baro bias: common Kalman variance P
-  float bias_gain = 0.0f;       //   and the gain of the current update
 
   std::vector<double> nis_window;
   std::size_t nis_next = 0;
