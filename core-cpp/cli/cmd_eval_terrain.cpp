@@ -57,9 +57,23 @@ int run_eval(const EvalArgs& a) {
   std::vector<double> ratios;
   std::size_t inside = 0, inside_unit = 0, epochs = 0;
   bool finite = true;
-  for (int k = 0; k < a.walks; ++k) {
+  // Walk k uses seed index k; a seed index whose route does not fit the tile (too steep, too
+  // many voids) is reported and replaced by the next unused index, up to 3 x walks indices.
+  int next_index = 0, done = 0;
+  while (done < a.walks) {
+    const int k = next_index++;
+    if (k >= 3 * a.walks)
+      throw std::runtime_error("eval-terrain: only " + std::to_string(done) + " of " + std::to_string(a.walks) +
+                               " walks fit the tile after " + std::to_string(k) + " seeds");
     const std::uint64_t ws = terrain::walk_seed(a.seed, static_cast<std::uint64_t>(k));
-    const terrain::SimulatedWalk walk = terrain::simulate_walk(*dem, sim, ws);
+    terrain::SimulatedWalk walk;
+    try {
+      walk = terrain::simulate_walk(*dem, sim, ws);
+    } catch (const std::runtime_error& e) {
+      std::printf("# walk seed index %d skipped: %s\n", k, e.what());
+      continue;
+    }
+    ++done;
     const terrain::WalkEvaluation ev = terrain::evaluate_walk(walk, dem, opt, ws ^ 0xA5A5A5A5ULL);
     const double ratio = ev.pf_drms_m / ev.dr_drms_m;
     ratios.push_back(ratio);

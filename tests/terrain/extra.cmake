@@ -29,3 +29,17 @@ add_test(NAME terrain.simulate_log
   COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/terrain/check_simulate.py"
           "$<TARGET_FILE:pdnav>" "${PDNAV_TERRAIN_TILE}" "${PDNAV_TERRAIN_SCRATCH}")
 set_tests_properties(terrain.simulate_log PROPERTIES FIXTURES_REQUIRED terrain_tile_andorra LABELS "terrain;cli" TIMEOUT 120)
+
+# A tile too small for any route (1 km across, 800 m edge margin): every walk is reported as
+# skipped with its reason and the command ends with a clear error, not a crash.
+set(PDNAV_TERRAIN_TINY "${PDNAV_TERRAIN_SCRATCH}/tiny_30m.pdem")
+add_test(NAME terrain.make_tiny_tile
+  COMMAND ${CMAKE_COMMAND} -E env /usr/bin/python3 "${PROJECT_SOURCE_DIR}/dem-tools/pdnav_dem.py" tile
+          "/vsizip/${PDNAV_SHARED_DATA_DIR}/terrain-andorra/N42E001.hgt.zip/N42E001.hgt"
+          -o "${PDNAV_TERRAIN_TINY}" --center 42.55 1.55 --radius 500 --cell 30 --fill-voids)
+set_tests_properties(terrain.make_tiny_tile PROPERTIES FIXTURES_SETUP terrain_tile_tiny LABELS "terrain;dem-tools")
+add_test(NAME terrain.eval_tile_too_small
+  COMMAND pdnav eval-terrain --dem "${PDNAV_TERRAIN_TINY}" --walks 2 --seed 1)
+set_tests_properties(terrain.eval_tile_too_small PROPERTIES FIXTURES_REQUIRED terrain_tile_tiny LABELS "terrain;cli"
+  PASS_REGULAR_EXPRESSION "skipped: simulate: DEM tile too small for the edge margin.*only 0 of 2 walks fit the tile after 6 seeds"
+  TIMEOUT 60)
