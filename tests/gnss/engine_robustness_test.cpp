@@ -42,6 +42,14 @@ void expect_finite(const std::vector<EpochSolution>& sols) {
   }
 }
 
+/// Flushes the engine after its rows were fed and returns its solutions, all checked finite.
+std::vector<EpochSolution> finish(GnssEngine& engine) {
+  engine.flush();
+  auto sols = engine.take_solutions();
+  expect_finite(sols);
+  return sols;
+}
+
 TEST(EngineRobustness, ClockDiscontinuityResetsTdcpAndKeepsAccuracy) {
   auto rows = read_raw();
   ASSERT_GT(rows.size(), 4000u);
@@ -56,9 +64,7 @@ TEST(EngineRobustness, ClockDiscontinuityResetsTdcpAndKeepsAccuracy) {
   }
   GnssEngine engine(GnssOptions{}, nav(), 1);
   for (const auto& r : rows) engine.feed(r);
-  engine.flush();
-  const auto sols = engine.take_solutions();
-  expect_finite(sols);
+  const auto sols = finish(engine);
   EXPECT_EQ(engine.exclusions().at("clock: hardware clock discontinuity (TDCP and KF clock reset)"), 1);
   const StaticAccuracy a = evaluate_static(sols, kTruth);
   EXPECT_LE(a.kf_rms_h_m, 2.5);
@@ -80,9 +86,7 @@ TEST(EngineRobustness, FullBiasJumpingAcrossTheInt64RangeIsNotLinked) {
   }
   GnssEngine engine(GnssOptions{}, nav(), 1);
   for (const auto& r : rows) engine.feed(r);
-  engine.flush();
-  const auto sols = engine.take_solutions();
-  expect_finite(sols);
+  const auto sols = finish(engine);
   EXPECT_GE(engine.exclusions().at("epoch: gap or time going backwards (no TDCP)"), 1);
   EXPECT_LE(evaluate_static(sols, kTruth).kf_rms_h_m, 2.5);
 }
@@ -105,9 +109,7 @@ TEST(EngineRobustness, MalformedValuesAreCountedNeverNaN) {
   GnssEngine engine(GnssOptions{}, nav(), 1);
   engine.feed(no_clock);
   for (const auto& r : rows) engine.feed(r);
-  engine.flush();
-  const auto sols = engine.take_solutions();
-  expect_finite(sols);
+  const auto sols = finish(engine);
   const auto& ex = engine.exclusions();
   EXPECT_GT(ex.at("cn0: missing"), 0);
   EXPECT_GT(ex.at("doppler: missing or non-finite"), 0);
@@ -132,9 +134,7 @@ TEST(EngineRobustness, FewerThanFourSatellitesCoastsThenLost) {
       EXPECT_EQ(e.status, EstimateStatus::kDegraded) << e.reason;
     }
   }
-  engine.flush();
-  const auto sols = engine.take_solutions();
-  expect_finite(sols);
+  const auto sols = finish(engine);
   EXPECT_GT(engine.exclusions().at("spp: fewer than 4 satellites"), 50);
   const Estimate e = engine.estimate();
   EXPECT_EQ(e.status, EstimateStatus::kLost) << e.reason;

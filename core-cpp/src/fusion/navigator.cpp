@@ -78,7 +78,7 @@ struct Navigator::Impl {
       // scale error (the user's stride vs 0.415 h): a preset with a scale state must cover it.
       // (The paper's four-state presets keep their per-step sigma_l only.)
       if (topt.step_scale_sigma > 0.0)
-        topt.step_scale_sigma = std::max(topt.step_scale_sigma, pdr_options(cfg).length.sigma_fraction);
+        topt.step_scale_sigma = std::max(topt.step_scale_sigma, pdr.options().length.sigma_fraction);
       terrain = std::make_unique<terrain::TerrainEngine>(topt, dem, seed);
     }
     if (!cfg.graph_path.empty() && wants(cfg.mode, EngineMode::kRoute)) {

@@ -180,8 +180,7 @@ struct TerrainEngine::Impl {
     w_sum = sum_sq = static_cast<double>(count);
     t_ns = t;
     initialized = true;
-    baro_sum_m = 0.0;
-    baro_count = 0;
+    restart_baro_average();
     walked_since_update_m = 0.0;
     last_pa = last_h_m = kNaN;
     stats.baro_jump_offset_m = 0.0;
@@ -199,6 +198,17 @@ struct TerrainEngine::Impl {
       baro = geo::BaroAltimeter(bo);
       baro.anchor(ground.elevation_m);
     }
+  }
+
+  /// Start a new barometer average (after an update, a sensor step, a stuck sensor, a restart).
+  void restart_baro_average() {
+    baro_sum_m = 0.0;
+    baro_count = 0;
+  }
+
+  /// Variance of z - (h + bias mean): R, plus the common bias variance P when Rao-Blackwellised.
+  double innovation_var() const {
+    return opt.measurement_var_m2 + (opt.rao_blackwell_baro_bias ? bias_var_m2 : 0.0);
   }
 
   // Barometer integrity state (feed_pressure).
@@ -233,8 +243,7 @@ struct TerrainEngine::Impl {
     if (opt.baro_stuck_s > 0.0 && ns_to_s(t) - ns_to_s(same_since_ns) >= opt.baro_stuck_s && !stats.baro_stuck) {
       stats.baro_stuck = true;
       ++stats.baro_stuck_events;
-      baro_sum_m = 0.0;  // the average so far holds stuck samples too
-      baro_count = 0;
+      restart_baro_average();  // the average so far holds stuck samples too
     }
     return stats.baro_stuck;
   }
@@ -249,8 +258,7 @@ struct TerrainEngine::Impl {
     if (jump) {
       ++stats.baro_jumps;
       stats.baro_jump_offset_m += dh;
-      baro_sum_m = 0.0;
-      baro_count = 0;
+      restart_baro_average();
     }
     last_h_m = h;
     last_h_ns = t;
@@ -269,8 +277,7 @@ struct TerrainEngine::Impl {
     const double z = measure ? baro_sum_m / baro_count : kNaN;
     propagate_and_weight(step, dt_s, z);
     if (measure) {
-      baro_sum_m = 0.0;
-      baro_count = 0;
+      restart_baro_average();
       walked_since_update_m = 0.0;
     }
     const double neff = neff_fraction();
@@ -303,7 +310,7 @@ struct TerrainEngine::Impl {
     const auto c_th = static_cast<float>(std::cos(step.heading_rad));
     const bool measure = std::isfinite(z);
     const auto zf = static_cast<float>(z);
-    const double innov_var = opt.measurement_var_m2 + (rb ? bias_var_m2 : 0.0);  // Eq. 5-7 (+ P)
+    const double innov_var = innovation_var();  // Eq. 5-7 (+ P)
     const auto inv_2r = static_cast<float>(0.5 / innov_var);
     const auto no_info_ll = static_cast<float>(-0.5 * opt.no_info_sigmas * opt.no_info_sigmas);
     const auto renorm = static_cast<float>(static_cast<double>(count) / w_sum);  // keeps mean weight ~1
@@ -445,7 +452,7 @@ struct TerrainEngine::Impl {
   void monitor(double s_valid, double s_r, double s_r2, float min_r2) {
     const double mean_r = s_r / s_valid;  // z - mean prediction
     const double var = std::max(0.0, s_r2 / s_valid - mean_r * mean_r);
-    const double r_var = opt.measurement_var_m2 + (opt.rao_blackwell_baro_bias ? bias_var_m2 : 0.0);
+    const double r_var = innovation_var();
     const double nis = mean_r * mean_r / (var + r_var);
     stats.last_nis = nis;
     nis_window[nis_next] = nis;
