@@ -32,6 +32,8 @@
 #include <vector>
 
 #include "pdnav/fusion/navigator.h"
+#include "pdnav/gnss/ephemeris.h"
+#include "pdnav/terrain/dem.h"
 
 namespace {
 
@@ -42,10 +44,13 @@ constexpr double kDemLon0 = 1.5218;
 constexpr int kDemCells = 48;
 constexpr double kDemCell_m = 30.0;
 
-/// Temp files made once per process: a synthetic DEM tile and a trimmed RINEX nav file.
+/// Made once per process: a synthetic DEM tile and a trimmed RINEX nav file, written to temp
+/// files and loaded once; every input's Navigator shares them (NavigatorConfig::dem,
+/// ::ephemeris), so an execution costs the samples, not reloading the files (their readers
+/// have their own targets, fuzz_dem_reader and fuzz_rinex_reader).
 struct Fixture {
-  std::string dem_path;
-  std::string nav_path;
+  std::shared_ptr<const pdnav::terrain::Dem> dem;
+  std::shared_ptr<const pdnav::gnss::EphemerisStore> ephemeris;
   /// PDNAV_FUZZ_CLAMP_TIMES=1 steers a long run around the known, reported findings
   /// (docs/reliability.md): every time (sample t_ns, TimeNanos, FullBiasNanos) within +-2^61
   /// (int64 overflow of time differences) and start/fix sigmas above 1e4 m or infinite set to
@@ -101,7 +106,7 @@ std::string write_synthetic_dem(const std::string& dir) {
 }
 
 /// The real GPS broadcast file of the Mountain View log, cut to its header and the records
-/// of 21-22 h (the log's epoch) so that loading it per input stays cheap.
+/// of 21-22 h (the log's epoch).
 std::string write_trimmed_rinex(const std::string& dir) {
   std::ifstream in(std::string(PDNAV_SHARED_DATA_DIR) + "/gnss-mountainview/hour2350.16n");
   if (!in) return "";
@@ -131,8 +136,14 @@ Fixture& fixture() {
     const char* dir = mkdtemp(tmpl);
     Fixture f;
     if (dir == nullptr) return f;
-    f.dem_path = write_synthetic_dem(dir);
-    f.nav_path = write_trimmed_rinex(dir);
+    // A fixture that fails to load throws here: the target aborts at its first input, loudly.
+    f.dem = std::make_shared<const pdnav::terrain::Dem>(pdnav::terrain::Dem::load(write_synthetic_dem(dir)));
+    const std::string nav_path = write_trimmed_rinex(dir);
+    if (!nav_path.empty()) {
+      auto eph = std::make_shared<pdnav::gnss::EphemerisStore>();
+      eph->load_rinex_nav(nav_path);
+      f.ephemeris = eph;
+    }
     const char* clamp = std::getenv("PDNAV_FUZZ_CLAMP_TIMES");
     f.clamp_times = clamp != nullptr && clamp[0] == '1';
     return f;
@@ -196,8 +207,8 @@ pdnav::fusion::NavigatorConfig make_config(std::uint8_t c, const Fixture& fx) {
   static const int kParticles[] = {50, 1, 200, 0};
   pdnav::fusion::NavigatorConfig cfg;
   cfg.mode = kModes[c & 3];
-  if (c & 4) cfg.dem_path = fx.dem_path;
-  if ((c & 8) && !fx.nav_path.empty()) cfg.nav_paths.push_back(fx.nav_path);
+  if (c & 4) cfg.dem = fx.dem;
+  if (c & 8) cfg.ephemeris = fx.ephemeris;
   cfg.particles = kParticles[(c >> 4) & 3];
   cfg.terrain_preset = (c & 64) ? "paper" : "srtm";
   if (c & 128) {

@@ -9,14 +9,19 @@
 #include <cstdint>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <random>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include "pdnav/fusion/navigator.h"
+#include "pdnav/gnss/ephemeris.h"
+#include "pdnav/io/log_reader.h"
+#include "pdnav/terrain/dem.h"
 #include "robustness_support.h"
 #include "test_data.h"
 
@@ -346,5 +351,69 @@ TEST(NavigatorRobustness, GarbageSamplesOfEveryTypeAreCountedNeverNaN) {
   EXPECT_TRUE(nav.estimate().valid()) << nav.estimate().reason;
 }
 
+
+// Already-loaded data (NavigatorConfig::dem / ::ephemeris) shared read-only by several
+// Navigators gives exactly what each Navigator loading its own copy from the paths gives,
+// also when the sharing Navigators run interleaved (no state kept in the shared objects).
+::testing::AssertionResult same_estimate(const Estimate& a, const Estimate& b) {
+  if (a.valid() != b.valid() || a.engine != b.engine || a.status != b.status)
+    return ::testing::AssertionFailure() << "valid/engine/status differ: " << a.reason << " vs " << b.reason;
+  if (a.en_m != b.en_m || a.cov_en_m2 != b.cov_en_m2 || a.position.lat_rad != b.position.lat_rad ||
+      a.position.lon_rad != b.position.lon_rad)
+    return ::testing::AssertionFailure() << "position differs: " << a.en_m.transpose() << " vs " << b.en_m.transpose();
+  return ::testing::AssertionSuccess();
+}
+
+TEST(NavigatorSharedData, PreloadedDemGivesTheSameWalkAsLoadingThePath) {
+  const auto dir = test::scratch_dir("reliability_shared_dem");
+  const std::string path = write_hill_pdem((dir / "hills.pdem").string(), 101, 30.0);
+  fusion::NavigatorConfig loading = config_with_dem(path, 200);
+  fusion::NavigatorConfig sharing = config_with_dem("", 200);
+  sharing.dem = std::make_shared<const terrain::Dem>(terrain::Dem::load(path));
+  fusion::Navigator own(loading, 3), shared_a(sharing, 3), shared_b(sharing, 3);
+  NavigatorWalk walk_own(own, 50.0, 5), walk_a(shared_a, 50.0, 5), walk_b(shared_b, 50.0, 5);
+  const auto heading = [](double t_s) { return t_s < 60.0 ? 0.3 : 1.9; };
+  for (int leg = 0; leg < 12; ++leg) {  // 120 s, the sharing two interleaved every 10 s
+    const auto none = [](double) {};
+    walk_own.run(10.0, heading, 100.0, none);
+    walk_a.run(10.0, heading, 100.0, none);
+    walk_b.run(10.0, heading, 100.0, none);
+    ASSERT_TRUE(same_estimate(own.estimate(), shared_a.estimate())) << "leg " << leg;
+    ASSERT_TRUE(same_estimate(own.estimate(), shared_b.estimate())) << "leg " << leg;
+  }
+  const Estimate e = own.estimate();
+  EXPECT_EQ(e.engine, EngineKind::kTerrain) << e.reason;
+  EXPECT_GT(e.en_m.norm(), 100.0);  // it walked: ~120 s x 1.8 steps/s x 0.7 m
+}
+
+TEST(NavigatorSharedData, PreloadedEphemerisGivesTheSameFixesAsLoadingThePath) {
+  const std::string nav_path = test::shared_data("gnss-mountainview/hour2350.16n");
+  fusion::NavigatorConfig loading;
+  loading.mode = fusion::EngineMode::kGnss;
+  loading.nav_paths.push_back(nav_path);
+  fusion::NavigatorConfig sharing;
+  sharing.mode = fusion::EngineMode::kGnss;
+  auto eph = std::make_shared<gnss::EphemerisStore>();
+  eph->load_rinex_nav(nav_path);
+  const std::size_t records = eph->size();
+  sharing.ephemeris = eph;
+  fusion::Navigator own(loading, 9), shared_a(sharing, 9), shared_b(sharing, 9);
+  io::LogReader log(test::shared_data("gnss-mountainview/pseudoranges_log_2016_08_22_14_45_50.txt"));
+  Sample s;
+  int raw_rows = 0, valid = 0;
+  while (raw_rows < 1500 && log.next(s)) {
+    raw_rows += std::holds_alternative<GnssRawSample>(s) ? 1 : 0;
+    own.feed(s);
+    shared_a.feed(s);
+    shared_b.feed(s);
+    ASSERT_TRUE(same_estimate(own.estimate(), shared_a.estimate())) << "row " << raw_rows;
+    ASSERT_TRUE(same_estimate(own.estimate(), shared_b.estimate())) << "row " << raw_rows;
+    valid += own.estimate().valid() ? 1 : 0;
+  }
+  EXPECT_EQ(raw_rows, 1500);
+  EXPECT_GT(valid, 0);  // the GNSS engine fixed from the shared broadcast orbits
+  EXPECT_EQ(eph->size(), records);  // and left them as they were
+  EXPECT_EQ(own.estimate().engine, EngineKind::kGnss);
+}
 }  // namespace
 }  // namespace pdnav::reliability

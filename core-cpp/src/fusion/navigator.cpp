@@ -70,8 +70,8 @@ struct Navigator::Impl {
   double pending_start_lat = kNaN, pending_start_lon = kNaN, pending_start_sigma = kNaN;
 
   Impl(const NavigatorConfig& c, std::uint64_t s) : cfg(c), seed(s), pdr(pdr_options(c)) {
-    if (!cfg.dem_path.empty() && wants(cfg.mode, EngineMode::kTerrain)) {
-      auto dem = std::make_shared<const terrain::Dem>(terrain::Dem::load(cfg.dem_path));
+    if ((cfg.dem || !cfg.dem_path.empty()) && wants(cfg.mode, EngineMode::kTerrain)) {
+      auto dem = cfg.dem ? cfg.dem : std::make_shared<const terrain::Dem>(terrain::Dem::load(cfg.dem_path));
       terrain::TerrainOptions topt = terrain::TerrainOptions::preset(cfg.terrain_preset);
       topt.particles = std::max(1, cfg.particles);
       // The step-length model's stated 1-sigma (APT height model: 10 %) is mostly a per-walk
@@ -81,19 +81,24 @@ struct Navigator::Impl {
         topt.step_scale_sigma = std::max(topt.step_scale_sigma, pdr.options().length.sigma_fraction);
       terrain = std::make_unique<terrain::TerrainEngine>(topt, dem, seed);
     }
-    if (!cfg.graph_path.empty() && wants(cfg.mode, EngineMode::kRoute)) {
-      auto graph = std::make_shared<const route::WalkGraph>(route::WalkGraph::load(cfg.graph_path));
+    if ((cfg.graph || !cfg.graph_path.empty()) && wants(cfg.mode, EngineMode::kRoute)) {
+      auto graph = cfg.graph ? cfg.graph : std::make_shared<const route::WalkGraph>(route::WalkGraph::load(cfg.graph_path));
       route = std::make_unique<route::RouteEngine>(route::RouteOptions{}, graph, seed + 1);
     }
     if (wants(cfg.mode, EngineMode::kGnss)) {
-      auto eph = std::make_shared<gnss::EphemerisStore>();
-      for (const std::string& p : cfg.nav_paths) eph->load_rinex_nav(p);
-      gnss = std::make_unique<gnss::GnssEngine>(gnss::GnssOptions{}, eph, seed + 2);
+      gnss = std::make_unique<gnss::GnssEngine>(gnss::GnssOptions{}, ephemeris(cfg), seed + 2);
     }
     if (cfg.mode == EngineMode::kTerrain && !terrain) throw std::invalid_argument("terrain engine needs a DEM (--dem)");
     if (cfg.mode == EngineMode::kRoute && !route) throw std::invalid_argument("route engine needs a walkway graph (--graph)");
     if (std::isfinite(cfg.start_lat_deg) && std::isfinite(cfg.start_lon_deg))
       pending_start_lat = cfg.start_lat_deg, pending_start_lon = cfg.start_lon_deg, pending_start_sigma = cfg.start_sigma_m;
+  }
+
+  static std::shared_ptr<const gnss::EphemerisStore> ephemeris(const NavigatorConfig& c) {
+    if (c.ephemeris) return c.ephemeris;
+    auto eph = std::make_shared<gnss::EphemerisStore>();
+    for (const std::string& p : c.nav_paths) eph->load_rinex_nav(p);
+    return eph;
   }
 
   static pdr::StepLengthModel length_model(double height_m, bool female) {
@@ -198,7 +203,7 @@ struct Navigator::Impl {
     if (route && started) route->feed(PositionFix{f.t_ns, f.lat_deg, f.lon_deg, std::isfinite(f.alt_m) ? f.alt_m : 0.0, sigma});
   }
 
-  bool gnss_has_nav() const { return gnss && !cfg.nav_paths.empty(); }
+  bool gnss_has_nav() const { return gnss && (cfg.ephemeris || !cfg.nav_paths.empty()); }
 
   bool in_order(const Sample& s) {
     const TimeNs t = sample_time_ns(s);

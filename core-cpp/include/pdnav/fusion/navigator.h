@@ -11,6 +11,10 @@
 #include "pdnav/geo/estimate.h"
 #include "pdnav/geo/samples.h"
 
+namespace pdnav::terrain { class Dem; }
+namespace pdnav::route { class WalkGraph; }
+namespace pdnav::gnss { class EphemerisStore; }
+
 namespace pdnav::fusion {
 
 enum class EngineMode { kAuto, kDeadReckoning, kTerrain, kRoute, kGnss };
@@ -37,6 +41,12 @@ struct NavigatorConfig {
   int particles = 500;                    // terrain engine (paper: 500 on a phone)
   std::string terrain_preset = "srtm-tuned";  // "paper" (lidar DEM), "srtm" (paper's 30 m tuning),
                                               // "srtm-tuned" (docs/terrain.md; the eval default)
+  /// Already-loaded data, shared read-only between Navigators (a session restarted on a mode
+  /// change, the fuzzer's millions of inputs); each one set is used instead of loading its
+  /// path above (dem_path, graph_path, nav_paths).
+  std::shared_ptr<const terrain::Dem> dem;
+  std::shared_ptr<const route::WalkGraph> graph;
+  std::shared_ptr<const gnss::EphemerisStore> ephemeris;
   /// Errors here are thrown from the constructor (std::runtime_error with file and reason).
 };
 
