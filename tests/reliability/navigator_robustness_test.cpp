@@ -351,7 +351,6 @@ TEST(NavigatorRobustness, GarbageSamplesOfEveryTypeAreCountedNeverNaN) {
   EXPECT_TRUE(nav.estimate().valid()) << nav.estimate().reason;
 }
 
-
 // Already-loaded data (NavigatorConfig::dem / ::ephemeris) shared read-only by several
 // Navigators gives exactly what each Navigator loading its own copy from the paths gives,
 // also when the sharing Navigators run interleaved (no state kept in the shared objects).
