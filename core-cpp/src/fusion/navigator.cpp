@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <map>
+#include <sstream>
 #include <stdexcept>
+
+#include <Eigen/LU>
 
 #include "pdnav/fusion/dead_reckoning.h"
 #include "pdnav/geo/frames.h"
@@ -35,7 +39,45 @@ const char* to_string(EngineMode m) {
   return "?";
 }
 
+const char* to_string(FusionMode m) {
+  switch (m) {
+    case FusionMode::kNotStarted: return "not-started";
+    case FusionMode::kGnss: return "gnss";
+    case FusionMode::kGnssDegraded: return "gnss-degraded";
+    case FusionMode::kRoute: return "route";
+    case FusionMode::kTerrain: return "terrain";
+    case FusionMode::kPdr: return "pdr";
+  }
+  return "?";
+}
+
 namespace {
+constexpr std::size_t kModeChangesKept = 1000;
+constexpr double kFusedRefreshS = 0.5;  // shown estimate refreshed at least this often (s of samples)
+constexpr std::size_t kModeChangesInOutput = 32;
+
+std::string fmt(double v, int prec = 1) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(prec);
+  s << v;
+  return s.str();
+}
+
+TimeNs ns(double s) { return static_cast<TimeNs>(s * 1e9); }
+
+/// Mahalanobis length of d in covariance c (inf when c is singular).
+double sigmas(const Eigen::Vector2d& d, const Eigen::Matrix2d& c) {
+  const double det = c.determinant();
+  if (!(det > 0.0)) return d.norm() > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
+  return std::sqrt(std::max(0.0, d.dot(c.inverse() * d)));
+}
+
+double wrap_2pi(double a) {
+  a = std::fmod(a, 2.0 * kPi);
+  return a < 0.0 ? a + 2.0 * kPi : a;
+}
+
 constexpr TimeNs kGnssFreshNs = 3 * kNsPerS;  // a GNSS estimate older than this is "lost"
 
 template <typename T, typename = void>
@@ -69,7 +111,39 @@ struct Navigator::Impl {
   geo::Geodetic start_position;
   double pending_start_lat = kNaN, pending_start_lon = kNaN, pending_start_sigma = kNaN;
 
-  Impl(const NavigatorConfig& c, std::uint64_t s) : cfg(c), seed(s), pdr(pdr_options(c)) {
+  // --- the fused estimate (mode kAuto) ---
+  bool fused = false;
+  FusionFilter ff;
+  PdrCalibrator cal;
+  geo::LocalFrame frame;                  // fused frame (the start position)
+  PdrCalibration applied;                 // calibration applied to the steps
+  FusionMode mode = FusionMode::kNotStarted;
+  std::deque<ModeChange> changes;
+  std::int64_t change_count = 0;
+  std::map<std::string, std::int64_t> counts;
+  TimeNs last_gnss_ns = -1;               // last accepted GNSS (Raw or Fix) position
+  TimeNs last_raw_pos_ns = -1;            // last Raw epoch with an SPP position (accepted or not)
+  double gnss_interval_s = 1.0;           // typical interval between accepted GNSS positions
+  bool gnss_degraded = false;             // the last accepted one was degraded / Fix-only
+  std::string gnss_what;                  // description of the last accepted GNSS measurement
+  std::string last_event;                 // the last notable filter event (for the reason)
+  TimeNs last_raw_row_ns = -1;            // t of the last Raw row fed (pending epoch)
+  bool raw_pending = false;
+  TimeNs last_anchor_ns = -1, last_aid_ns = -1, last_aid_ok_ns = -1;
+  FusionMode aid_engine = FusionMode::kPdr;
+  int route_misses = 0, terrain_misses = 0;
+  double height_m = 0.0;
+  // shown (blended) estimate
+  bool shown_valid = false;
+  Eigen::Vector2d offset_en_m = Eigen::Vector2d::Zero();  // shown - filter
+  Eigen::Vector2d shown_en_m = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d shown_cov = Eigen::Matrix2d::Identity();
+  TimeNs shown_t_ns = 0;
+  Estimate shown;
+
+  Impl(const NavigatorConfig& c, std::uint64_t s)
+      : cfg(c), seed(s), pdr(pdr_options(c)), fused(c.mode == EngineMode::kAuto), ff(c.fusion.filter),
+        cal(c.fusion.calibration) {
     if ((cfg.dem || !cfg.dem_path.empty()) && wants(cfg.mode, EngineMode::kTerrain)) {
       auto dem = cfg.dem ? cfg.dem : std::make_shared<const terrain::Dem>(terrain::Dem::load(cfg.dem_path));
       terrain::TerrainOptions topt = terrain::TerrainOptions::preset(cfg.terrain_preset);
@@ -127,6 +201,7 @@ struct Navigator::Impl {
     if (route) route->feed(PositionFix{t_ns, lat_deg, lon_deg, 0.0, sigma_m});
     start_position = g;
     pdr.set_location(g, first_utc_ms);  // WMM declination at the session's date
+    if (fused) start_fused(g, sigma_m, t_ns);
     started = true;
   }
 
@@ -170,6 +245,10 @@ struct Navigator::Impl {
       ++steps;
       maybe_start(s.t_ns);
       dr.feed(s);
+      if (fused && started) {
+        fused_step(s);
+        continue;
+      }
       if (terrain) terrain->feed(s);
       if (route) route->feed(s);
     }
@@ -179,9 +258,7 @@ struct Navigator::Impl {
 
   void drain_gnss() {
     if (!gnss) return;
-    for (const gnss::EpochSolution& sol : gnss->take_solutions()) {
-      (void)sol;
-    }
+    std::vector<gnss::EpochSolution> sols = gnss->take_solutions();
     const Estimate g = gnss->estimate();
     if (g.status == EstimateStatus::kOk) {
       last_gnss_ok_ns = g.t_ns;
@@ -192,6 +269,8 @@ struct Navigator::Impl {
         start(pending_start_lat, pending_start_lon, pending_start_sigma, g.t_ns);
       }
     }
+    if (fused && started)
+      for (const gnss::EpochSolution& sol : sols) fused_epoch(sol);
   }
 
   void on_fix(const FixSample& f) {
@@ -200,6 +279,10 @@ struct Navigator::Impl {
     if (p != "GPS" || !std::isfinite(f.lat_deg) || !std::isfinite(f.lon_deg)) return;
     const double sigma = std::isfinite(f.accuracy_m) && f.accuracy_m > 0 ? f.accuracy_m : 15.0;
     if (!started && !std::isfinite(pending_start_lat) && !gnss_has_nav()) start(f.lat_deg, f.lon_deg, sigma, f.t_ns);
+    if (fused) {
+      if (started) fused_fix(f);
+      return;
+    }
     if (route && started) route->feed(PositionFix{f.t_ns, f.lat_deg, f.lon_deg, std::isfinite(f.alt_m) ? f.alt_m : 0.0, sigma});
   }
 
@@ -235,6 +318,12 @@ struct Navigator::Impl {
   void feed(const Sample& s) {
     if (!in_order(s)) return;
     note_utc(s);
+    if (gnss && raw_pending && !std::holds_alternative<GnssRawSample>(s) &&
+        sample_time_ns(s) > last_raw_row_ns + ns(cfg.fusion.gnss_flush_after_s)) {
+      raw_pending = false;  // the epoch is complete: use it now, not when the next one starts
+      gnss->flush();
+      drain_gnss();
+    }
     std::visit(
         [&](const auto& x) {
           using T = std::decay_t<decltype(x)>;
@@ -248,6 +337,10 @@ struct Navigator::Impl {
           } else if constexpr (std::is_same_v<T, GnssRawSample> || std::is_same_v<T, NavMessageSample>) {
             if (gnss) {
               gnss->feed(x);
+              if constexpr (std::is_same_v<T, GnssRawSample>) {
+                raw_pending = true;
+                last_raw_row_ns = x.t_ns;
+              }
               drain_gnss();
             }
           } else if constexpr (std::is_same_v<T, FixSample>) {
@@ -257,9 +350,314 @@ struct Navigator::Impl {
           }
         },
         s);
+    // time passes without steps or GNSS (standing, an outage): the covariance grows, the mode
+    // follows, at most every fused_refresh_s
+    if (fused && started && ff.initialized()) {
+      const TimeNs t = sample_time_ns(s);
+      if (t - shown_t_ns >= ns(kFusedRefreshS)) {
+        ff.advance_to(t);
+        refresh_mode(t);
+        update_shown(t);
+      }
+    }
+  }
+
+  // ------------------------------------------------------------------------------------------
+  // The fused estimate (docs/fusion.md)
+  const FusionOptions& fo() const { return cfg.fusion; }
+
+  void start_fused(const geo::Geodetic& g, double sigma_m, TimeNs t_ns) {
+    const bool restart = ff.initialized();
+    frame = geo::LocalFrame(g);
+    ff.initialize(Eigen::Vector2d::Zero(), sigma_m, t_ns);
+    if (applied.valid) ff.set_residual_uncertainty(applied.heading_bias_sigma_rad * applied.heading_bias_sigma_rad,
+                                                   applied.scale_sigma * applied.scale_sigma);
+    cal.reset();  // the calibration track restarts in the new frame; the applied one is kept
+    shown_valid = false;
+    offset_en_m.setZero();
+    last_gnss_ns = -1;
+    height_m = g.h_m;
+    set_mode(t_ns, FusionMode::kPdr,
+             std::string(restart ? "start position reset" : "started") + " at " + fmt(g.lat_deg(), 6) + ", " +
+                 fmt(g.lon_deg(), 6) + " (sigma " + fmt(sigma_m) + " m): dead reckoning until GNSS is accepted");
+    update_shown(t_ns);
+  }
+
+  void set_mode(TimeNs t, FusionMode to, const std::string& why) {
+    if (to == mode) return;
+    ModeChange c{t, mode, to, why};
+    changes.push_back(c);
+    while (changes.size() > kModeChangesKept) changes.pop_front();
+    ++change_count;
+    mode = to;
+  }
+
+  PdrStep calibrated(const PdrStep& s) const {
+    PdrStep c = s;
+    if (!applied.valid) return c;
+    c.length_m = s.length_m * applied.scale;
+    c.length_sigma_m = s.length_sigma_m * applied.scale;
+    c.heading_rad = wrap_2pi(s.heading_rad - applied.heading_bias_rad);
+    return c;
+  }
+
+  void fused_step(const PdrStep& raw) {
+    cal.add_step(raw);
+    const PdrStep c = calibrated(raw);
+    ff.predict(c);
+    if (terrain) terrain->feed(c);
+    if (route) route->feed(c);
+    for (const PdrTurn& t : pdr.take_turns())
+      if (route) route->feed(t);
+    engine_aid(c.t_ns);
+    refresh_mode(c.t_ns);
+    update_shown(c.t_ns);
+  }
+
+  /// A measurement update moved the filter by `before -> now`: blend it into the shown position
+  /// when it is larger than blend_above_sigma of the shown covariance.
+  void after_update(const Eigen::Vector2d& before) {
+    const Eigen::Vector2d delta = ff.position_en_m() - before;
+    if (shown_valid && sigmas(delta, shown_cov) > fo().blend_above_sigma) offset_en_m -= delta;
+  }
+
+  void accepted_gnss(TimeNs t, const Eigen::Vector2d& z, double sigma_m, bool degraded, const std::string& what) {
+    if (last_gnss_ns >= 0) {
+      const double dt = static_cast<double>(t - last_gnss_ns) * 1e-9;
+      if (dt > 0.0 && dt < 60.0) gnss_interval_s = 0.8 * gnss_interval_s + 0.2 * dt;
+    }
+    last_gnss_ns = t;
+    gnss_degraded = degraded;
+    gnss_what = what;
+    cal.add_gnss(t, z, sigma_m);
+    const PdrCalibration& p = cal.published();
+    if (p.valid && p.t_ns != applied.t_ns) {
+      if (!applied.valid) ++counts["calibration published"];
+      applied = p;
+      ff.set_residual_uncertainty(p.heading_bias_sigma_rad * p.heading_bias_sigma_rad, p.scale_sigma * p.scale_sigma);
+    }
+  }
+
+  void note_result(const PositionUpdateResult& r, const std::string& src) {
+    if (r.accepted) {
+      if (r.forced) {
+        ++counts["GNSS: forced correction (consistent disagreement)"];
+        last_event = src + ": " + r.reason;
+      } else if (r.reacquired) {
+        ++counts["GNSS: re-acquired after an outage"];
+        last_event = src + ": " + r.reason;
+      }
+    } else {
+      ++counts[src + ": " + (r.reason.rfind("re-acq", 0) == 0 ? "waiting for re-acquisition agreement" : "rejected by the innovation gate")];
+      last_event = src + ": " + r.reason;
+    }
+  }
+
+  void fused_epoch(const gnss::EpochSolution& sol) {
+    const TimeNs t = sol.t_ns;
+    if (sol.disp_dt_s > 0.0 && !sol.disp_source.empty()) {
+      const double sd = sol.disp_source == "tdcp" ? fo().tdcp_sigma_m : fo().doppler_sigma_mps * sol.disp_dt_s;
+      const Eigen::Vector2d before = ff.position_en_m();
+      double nis = 0.0;
+      if (ff.update_displacement(t, t - ns(sol.disp_dt_s), sol.tdcp_disp_m.head<2>(), sd * sd * Eigen::Matrix2d::Identity(), &nis))
+        ++counts["GNSS: " + sol.disp_source + " displacement used"];
+      else if (ff.clone_t_ns() >= 0)
+        ++counts["GNSS: " + sol.disp_source + " displacement rejected or unmatched"];
+      after_update(before);
+    }
+    if (sol.spp_ok) {
+      last_raw_pos_ns = t;
+      const geo::Geodetic g = geo::to_geodetic(sol.spp);
+      const Eigen::Vector2d z = frame.to_enu(sol.spp).p_m.head<2>();
+      const double hdop = std::isfinite(sol.hdop) && sol.hdop > 0.0 ? sol.hdop : fo().default_hdop;
+      const bool degraded = sol.sats_used < fo().min_sats_ok;
+      double sigma = std::max(fo().min_spp_sigma_m, fo().spp_uere_m * hdop);
+      if (degraded) sigma *= fo().degraded_sigma_scale;
+      const Eigen::Vector2d before = ff.position_en_m();
+      const PositionUpdateResult r = ff.update_position(t, z, sigma * sigma * Eigen::Matrix2d::Identity());
+      note_result(r, "GNSS");
+      if (r.accepted) {
+        if (std::isfinite(g.h_m)) height_m = g.h_m;
+        accepted_gnss(t, z, sigma, degraded,
+                      "SPP " + std::to_string(sol.sats_used) + " sats, sigma " + fmt(sigma) + " m" +
+                          (sol.disp_source.empty() ? "" : " + " + sol.disp_source));
+        if (r.reacquired) refresh_mode(t, "GNSS " + r.reason);
+      }
+      after_update(before);
+    }
+    ff.clone(t);
+    anchor_engines(t);
+    refresh_mode(t);
+    update_shown(t);
+  }
+
+  void fused_fix(const FixSample& f) {
+    if (last_raw_pos_ns >= 0 && f.t_ns - last_raw_pos_ns <= ns(fo().fix_fallback_after_s)) return;  // Raw is better
+    const double acc = std::isfinite(f.accuracy_m) && f.accuracy_m > 0 ? f.accuracy_m : fo().fix_default_accuracy_m;
+    const double sigma = acc / 1.51 * fo().fix_sigma_scale;  // 68 % radius -> 1-sigma per axis
+    const geo::Geodetic g = geo::Geodetic::from_deg(f.lat_deg, f.lon_deg, std::isfinite(f.alt_m) ? f.alt_m : 0.0);
+    const Eigen::Vector2d z = frame.to_enu(g).p_m.head<2>();
+    const Eigen::Vector2d before = ff.position_en_m();
+    const PositionUpdateResult r = ff.update_position(f.t_ns, z, sigma * sigma * Eigen::Matrix2d::Identity());
+    note_result(r, "Fix");
+    if (r.accepted) {
+      if (std::isfinite(f.alt_m)) height_m = f.alt_m;
+      accepted_gnss(f.t_ns, z, sigma, true, "chipset Fix, accuracy " + fmt(acc) + " m");
+      if (r.reacquired) refresh_mode(f.t_ns, "Fix " + r.reason);
+    }
+    after_update(before);
+    anchor_engines(f.t_ns);
+    refresh_mode(f.t_ns);
+    update_shown(f.t_ns);
+  }
+
+  geo::Geodetic fused_geodetic(const Eigen::Vector2d& en) const {
+    geo::Geodetic g = frame.to_geodetic(geo::Enu(en.x(), en.y(), 0.0));
+    g.h_m = height_m;
+    return g;
+  }
+
+  bool gnss_fresh(TimeNs t) const {
+    if (last_gnss_ns < 0) return false;
+    const double limit_s = std::max(fo().gnss_fresh_s, 1.5 * gnss_interval_s + 1.0);
+    return t - last_gnss_ns <= ns(limit_s);
+  }
+
+  /// While GNSS is good, terrain and route are held to the fused estimate (a wrong lock is
+  /// found and corrected on the way).
+  void anchor_engines(TimeNs t) {
+    if (!gnss_fresh(t) || t - last_gnss_ns > ns(1.0) + ns(gnss_interval_s)) return;
+    if (last_anchor_ns >= 0 && t - last_anchor_ns < ns(fo().anchor_interval_s)) return;
+    last_anchor_ns = t;
+    const Eigen::Vector2d m = ff.position_en_m();
+    const Eigen::Matrix2d p = ff.position_cov_m2();
+    const double sigma = std::sqrt(std::max(1e-4, 0.5 * (p.trace() + std::sqrt(std::pow(p(0, 0) - p(1, 1), 2) + 4 * p(0, 1) * p(0, 1)))));
+    const geo::Geodetic g = fused_geodetic(m);
+    auto check = [&](const Estimate& e, const char* name) {
+      if (!e.valid()) return;
+      const Eigen::Vector2d d = frame.to_enu(e.position).p_m.head<2>() - m;
+      if (sigmas(d, e.cov_en_m2 + p) > 3.0) {
+        ++counts[std::string(name) + ": wrong lock corrected while GNSS is good"];
+        last_event = std::string(name) + " engine was " + fmt(d.norm()) + " m off the GNSS-fused estimate: re-anchored";
+      }
+    };
+    if (terrain) {
+      check(terrain->estimate(), "terrain");
+      terrain->initialize(g, sigma, t);
+    }
+    if (route) {
+      check(route->estimate(), "route");
+      route->feed(PositionFix{t, g.lat_deg(), g.lon_deg(), g.h_m, sigma});
+    }
+    route_misses = terrain_misses = 0;
+    ++counts["engines re-anchored to the fused estimate"];
+  }
+
+  /// In an outage, the route and terrain engines' estimates are measurements.
+  void engine_aid(TimeNs t) {
+    if (last_gnss_ns >= 0 && t - last_gnss_ns < ns(fo().aid_after_s)) return;
+    if (last_aid_ns >= 0 && t - last_aid_ns < ns(fo().aid_interval_s)) return;
+    last_aid_ns = t;
+    auto aid = [&](const Estimate& e, FusionMode which, int* misses, const char* name) {
+      if (e.status != EstimateStatus::kOk) return false;
+      const Eigen::Vector2d z = frame.to_enu(e.position).p_m.head<2>();
+      Eigen::Matrix2d r = e.cov_en_m2 * fo().aid_var_scale;
+      r += fo().aid_min_sigma_m * fo().aid_min_sigma_m * Eigen::Matrix2d::Identity();
+      const Eigen::Vector2d before = ff.position_en_m();
+      const PositionUpdateResult res = ff.update_position(t, z, r, /*use_gate_policy=*/false);
+      after_update(before);
+      if (res.accepted) {
+        *misses = 0;
+        last_aid_ok_ns = t;
+        aid_engine = which;
+        ++counts[std::string(name) + ": used as a measurement"];
+        return true;
+      }
+      ++counts[std::string(name) + ": rejected by the innovation gate"];
+      if (++*misses >= fo().wrong_lock_after) {
+        *misses = 0;
+        ++counts[std::string(name) + ": wrong lock corrected (re-anchored to the fused estimate)"];
+        last_event = std::string(name) + " engine disagreed " + std::to_string(fo().wrong_lock_after) +
+                     " times in a row (" + res.reason + "): re-anchored";
+        const Eigen::Matrix2d p = ff.position_cov_m2();
+        const double sigma = std::sqrt(std::max(1e-4, 0.5 * p.trace()));
+        const geo::Geodetic g = fused_geodetic(ff.position_en_m());
+        if (which == FusionMode::kTerrain && terrain) terrain->initialize(g, sigma, t);
+        if (which == FusionMode::kRoute && route) route->feed(PositionFix{t, g.lat_deg(), g.lon_deg(), g.h_m, sigma});
+      }
+      return false;
+    };
+    bool used = false;
+    if (route && fo().aid_with_route) used = aid(route->estimate(), FusionMode::kRoute, &route_misses, "route");
+    if (!used && terrain && fo().aid_with_terrain) aid(terrain->estimate(), FusionMode::kTerrain, &terrain_misses, "terrain");
+  }
+
+  void refresh_mode(TimeNs t, const std::string& why_in = "") {
+    FusionMode to = FusionMode::kPdr;
+    std::string why = why_in;
+    if (gnss_fresh(t)) {
+      to = gnss_degraded ? FusionMode::kGnssDegraded : FusionMode::kGnss;
+      if (why.empty()) why = "GNSS accepted: " + gnss_what;
+    } else if (last_aid_ok_ns >= 0 && t - last_aid_ok_ns <= ns(2.0 * fo().aid_interval_s)) {
+      to = aid_engine;
+      if (why.empty())
+        why = std::string("no GNSS for ") + fmt(static_cast<double>(t - std::max<TimeNs>(0, last_gnss_ns)) * 1e-9) +
+              " s: " + to_string(aid_engine) + " engine used as a measurement";
+    } else if (why.empty()) {
+      why = last_gnss_ns >= 0 ? "no usable GNSS for " + fmt(static_cast<double>(t - last_gnss_ns) * 1e-9) +
+                                    " s: dead reckoning on the " + (applied.valid ? "calibrated" : "uncalibrated") + " PDR"
+                              : "no GNSS accepted yet: dead reckoning";
+      if (!last_event.empty()) why += " (last: " + last_event + ")";
+    }
+    set_mode(t, to, why);
+  }
+
+  void update_shown(TimeNs t) {
+    const Eigen::Vector2d m = ff.position_en_m();
+    const Eigen::Matrix2d p = ff.position_cov_m2();
+    if (!shown_valid) {
+      offset_en_m.setZero();
+    } else {
+      // the blend: the offset decays with blend_tau_s, one move bounded by max_shown_jump_sigma
+      const double dt = std::max(0.0, static_cast<double>(t - shown_t_ns) * 1e-9);
+      const Eigen::Vector2d decayed = offset_en_m * std::exp(-dt / fo().blend_tau_s);
+      Eigen::Vector2d target = m + decayed;
+      const Eigen::Vector2d move = target - shown_en_m;
+      const double k = sigmas(move, shown_cov);
+      if (k > fo().max_shown_jump_sigma && std::isfinite(k)) target = shown_en_m + move * (fo().max_shown_jump_sigma / k);
+      offset_en_m = target - m;
+      if (offset_en_m.norm() < 1e-3) offset_en_m.setZero();
+    }
+    shown_en_m = m + offset_en_m;
+    shown_cov = p + offset_en_m * offset_en_m.transpose();
+    shown_t_ns = t;
+    shown_valid = true;
+    Estimate e;
+    e.t_ns = t;
+    e.position = fused_geodetic(shown_en_m);
+    e.en_m = shown_en_m;
+    e.cov_en_m2 = shown_cov;
+    e.vertical_sigma_m = 0.0;
+    switch (mode) {
+      case FusionMode::kGnss: e.engine = EngineKind::kGnss; e.status = EstimateStatus::kOk; break;
+      case FusionMode::kGnssDegraded: e.engine = EngineKind::kGnss; e.status = EstimateStatus::kDegraded; break;
+      case FusionMode::kRoute: e.engine = EngineKind::kRoute; e.status = EstimateStatus::kDegraded; break;
+      case FusionMode::kTerrain: e.engine = EngineKind::kTerrain; e.status = EstimateStatus::kDegraded; break;
+      default: e.engine = EngineKind::kDeadReckoning; e.status = EstimateStatus::kDegraded; break;
+    }
+    e.reason = std::string("fused (") + to_string(mode) + "): " + (changes.empty() ? "" : changes.back().reason);
+    if (applied.valid)
+      e.reason += "; PDR scale " + fmt(applied.scale, 3) + " heading bias " + fmt(rad_to_deg(applied.heading_bias_rad)) + " deg";
+    if (offset_en_m.norm() > 0.0) e.reason += "; blending " + fmt(offset_en_m.norm()) + " m";
+    shown = std::move(e);
   }
 
   Estimate choose() const {
+    if (fused) {
+      if (shown_valid) return shown;
+      Estimate d = dr.estimate();
+      return d;
+    }
     if (gnss && wants(cfg.mode, EngineMode::kGnss)) {
       Estimate g = gnss->estimate();
       const bool fresh = last_gnss_ok_ns >= 0 && last_t_ns - last_gnss_ok_ns <= kGnssFreshNs;
@@ -311,7 +709,18 @@ NavigatorOutput Navigator::output(std::size_t max_particles) const {
   }
   if (impl_->route) o.engines.push_back(impl_->route->estimate());
   if (impl_->gnss) o.engines.push_back(impl_->gnss->estimate());
+  o.mode = impl_->mode;
+  o.mode_change_count = impl_->change_count;
+  const std::size_t n = std::min(kModeChangesInOutput, impl_->changes.size());
+  o.mode_changes.assign(impl_->changes.end() - static_cast<std::ptrdiff_t>(n), impl_->changes.end());
+  o.calibration = impl_->applied;
   return o;
+}
+
+std::vector<ModeChange> Navigator::mode_changes() const { return {impl_->changes.begin(), impl_->changes.end()}; }
+
+std::vector<std::pair<std::string, std::int64_t>> Navigator::fusion_counts() const {
+  return {impl_->counts.begin(), impl_->counts.end()};
 }
 
 std::vector<std::pair<std::string, std::int64_t>> Navigator::ignored() const {

@@ -1,13 +1,17 @@
 // fusion::Navigator: the single entry point of the core for the app (JNI), the replay CLI
 // and the tests. Feed it the time-ordered sample stream; ask it for the estimate.
 // It runs PDR on the inertial samples and hands steps/turns/pressure/GNSS to the engines,
-// and picks the estimate to show (GNSS when healthy, else route, else terrain, else DR).
+// In the default mode (kAuto) the estimate shown is the fused one (FusionFilter: calibrated PDR
+// prediction, gated GNSS / TDCP, terrain and route as measurements in outages, blended so it
+// never jumps; docs/fusion.md); an explicit engine mode shows that engine alone.
 #pragma once
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "pdnav/fusion/fusion_filter.h"
+#include "pdnav/fusion/pdr_calibrator.h"
 #include "pdnav/geo/estimate.h"
 #include "pdnav/geo/samples.h"
 
@@ -22,6 +26,56 @@ EngineMode engine_mode_from_string(const std::string& s);  // "auto", "dr", "ter
 const char* to_string(EngineMode m);
 
 inline constexpr double kDefaultUserHeightM = 1.75;
+
+/// Hand-over rules and measurement models of the fused estimate (kAuto); docs/fusion.md.
+struct FusionOptions {
+  FusionFilterOptions filter;
+  PdrCalibrationOptions calibration;
+  // GNSS measurement models
+  double spp_uere_m = 4.0;            // phone pseudorange 1-sigma (Walker 2019 Sec. 2: 3-5 m class)
+  double min_spp_sigma_m = 2.0;       // floor of an SPP position 1-sigma per axis
+  double default_hdop = 2.0;          // when an epoch reports none
+  int min_sats_ok = 6;                // fewer used satellites: degraded (sigma scaled below)
+  double degraded_sigma_scale = 1.5;
+  double tdcp_sigma_m = 0.10;         // per axis, TDCP displacement (cm-level + phase-centre motion)
+  double doppler_sigma_mps = 0.30;    // per axis, Doppler-derived velocity
+  /// Chipset Fix rows: Android accuracy is a 68 % horizontal radius, sigma = accuracy / 1.51;
+  /// scaled for their time correlation (the chipset's own filter). Used only when no Raw
+  /// epoch has given a position for fix_fallback_after_s.
+  double fix_sigma_scale = 1.5;
+  double fix_default_accuracy_m = 15.0;
+  double fix_fallback_after_s = 3.0;
+  /// Flush a pending GNSS epoch when another sensor's sample is this much later (an epoch is
+  /// used when it is complete, not when the next one starts).
+  double gnss_flush_after_s = 0.5;
+  // hand-over
+  double gnss_fresh_s = 3.0;          // GNSS mode while a GNSS position was accepted this recently
+                                      // (or 1.5 x the epoch interval + 1 s when duty-cycled)
+  double anchor_interval_s = 5.0;     // while GNSS is good: terrain/route re-anchored this often
+  double aid_after_s = 5.0;           // no GNSS this long: terrain/route become measurements
+  double aid_interval_s = 10.0;       // ... at most this often (they share the PDR steps)
+  double aid_var_scale = 4.0;         // ... with their covariance times this (correlation)
+  double aid_min_sigma_m = 5.0;       // ... floored at this 1-sigma
+  bool aid_with_route = true;
+  bool aid_with_terrain = true;
+  int wrong_lock_after = 3;           // engine rejected this many times in a row: re-anchored
+  // blending of the shown position
+  double blend_above_sigma = 1.0;     // corrections larger than this (sigma) are blended in
+  double blend_tau_s = 2.0;           // exponential blend time constant
+  double max_shown_jump_sigma = 2.5;  // hard bound of one shown move, sigma of the shown covariance
+};
+
+/// What drives the fused estimate.
+enum class FusionMode { kNotStarted, kGnss, kGnssDegraded, kRoute, kTerrain, kPdr };
+const char* to_string(FusionMode m);
+
+/// One hand-over (or start) of the fused estimate, with its reason.
+struct ModeChange {
+  TimeNs t_ns = 0;
+  FusionMode from = FusionMode::kNotStarted;
+  FusionMode to = FusionMode::kNotStarted;
+  std::string reason;
+};
 
 /// Plain configuration (what the app's settings screen and the CLI flags set).
 struct NavigatorConfig {
@@ -47,6 +101,7 @@ struct NavigatorConfig {
   std::shared_ptr<const terrain::Dem> dem;
   std::shared_ptr<const route::WalkGraph> graph;
   std::shared_ptr<const gnss::EphemerisStore> ephemeris;
+  FusionOptions fusion;                   // the fused estimate (mode kAuto)
   /// Errors here are thrown from the constructor (std::runtime_error with file and reason).
 };
 
@@ -56,6 +111,10 @@ struct NavigatorOutput {
   std::vector<Estimate> engines;           // every running engine's own estimate
   std::int64_t steps = 0;                  // steps detected so far
   std::vector<Eigen::Vector2d> particles_en_m;  // a thinned particle cloud (terrain), may be empty
+  FusionMode mode = FusionMode::kNotStarted;    // what drives the fused estimate now (kAuto)
+  std::vector<ModeChange> mode_changes;         // the most recent ones (up to 32), oldest first
+  std::int64_t mode_change_count = 0;           // all since the start
+  PdrCalibration calibration;                   // the PDR calibration in use (valid once published)
 };
 
 class Navigator {
@@ -75,6 +134,10 @@ class Navigator {
   NavigatorOutput output(std::size_t max_particles = 200) const;
   /// Samples ignored so far, by reason.
   std::vector<std::pair<std::string, std::int64_t>> ignored() const;
+  /// Fused-estimate hand-overs with reasons (the last 1000), oldest first.
+  std::vector<ModeChange> mode_changes() const;
+  /// Fusion counters (GNSS rejected by the gate, forced corrections, re-anchors, ...).
+  std::vector<std::pair<std::string, std::int64_t>> fusion_counts() const;
 
  private:
   struct Impl;

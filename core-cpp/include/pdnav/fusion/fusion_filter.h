@@ -1,0 +1,118 @@
+// The fused estimator: an error-tolerant EKF driven by (calibrated) PDR steps, with GNSS
+// positions (SPP or chipset Fix, with their covariances), TDCP / Doppler displacements
+// (stochastic cloning of the previous epoch's position) and, during outages, the terrain and
+// route engines' estimates as measurements. State (local ENU frame of the session start):
+//   x = [e, n, db, ds, e_c, n_c]
+// e, n position; db residual heading bias and ds residual step-length scale error left after
+// the sliding-window calibration (PdrCalibrator); e_c, n_c the clone of the position at the
+// last GNSS epoch. Prediction and measurement equations, gating and the re-acquisition rule
+// are in docs/fusion.md. Walker et al., Remote Sensing 2019, Sec. 3, is the starting point
+// (PDR prediction, SPP + TDCP measurements of a robust KF); the windowed gate replaces its
+// single-epoch residual test.
+#pragma once
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pdnav/geo/events.h"
+#include "pdnav/geo/units.h"
+
+namespace pdnav::fusion {
+
+struct FusionFilterOptions {
+  // --- prediction ---
+  double initial_scale_sigma = 0.10;               // APT height model 1-sigma 10 % (Zhu 2015, Sec. V-C)
+  double initial_heading_bias_sigma_rad = 10.0 * kDegToRad;  // rotation-vector heading accuracy class
+  /// Random walk of the residual heading bias (magnetic disturbances, gyro drift): (2 deg)^2 per minute.
+  double heading_bias_rw_rad2ps = (2.0 * kDegToRad) * (2.0 * kDegToRad) / 60.0;
+  /// Random walk of the residual step scale (pace changes): (1 %)^2 per minute.
+  double scale_rw_1ps = 1e-4 / 60.0;
+  double min_step_heading_sigma_rad = 3.0 * kDegToRad;  // floor of a step's white heading noise
+  double min_step_length_sigma_m = 0.05;                // floor of a step's white length noise
+  /// Motion no step reported (shuffling, a missed detection): position random walk, m^2/s,
+  /// applied to the time beyond undetected_after_s since the last step.
+  double undetected_motion_q_m2ps = 0.05;
+  double undetected_after_s = 1.5;
+  // --- gating ---
+  double gate_chi2 = 11.83;          // chi^2(2 dof) at 99.73 % = a 3-sigma innovation
+  int confirm_epochs = 5;            // consecutive rejected epochs that agree = a real correction
+  double confirm_window_s = 20.0;    // ... within this time
+  double agreement_p = 0.99;         // mutual-consistency test of those epochs (chi^2 quantile)
+  double reacquire_after_s = 30.0;   // no accepted position this long = an outage
+  int reacquire_epochs = 2;          // after an outage, this many agreeing epochs before use
+  double displacement_gate_chi2 = 13.82;  // TDCP / Doppler: chi^2(2) at 99.9 % (cycle slips)
+};
+
+struct PositionUpdateResult {
+  bool accepted = false;
+  bool forced = false;         // accepted after consistent disagreement (covariance inflated)
+  bool reacquired = false;     // first use after an outage
+  double nis = 0.0;            // normalised innovation squared against the prediction
+  double innovation_m = 0.0;   // |z - prediction|
+  std::string reason;          // why (rejected, waiting for agreement, accepted ...)
+};
+
+class FusionFilter {
+ public:
+  explicit FusionFilter(const FusionFilterOptions& opt = {}) : opt_(opt) {}
+  void initialize(const Eigen::Vector2d& en_m, double sigma_m, TimeNs t_ns);
+  bool initialized() const { return initialized_; }
+
+  /// Propagate with one (calibrated) step.
+  void predict(const PdrStep& step);
+  /// The calibration changed: the residual bias/scale states restart at zero with these
+  /// variances (their cross-covariances with the position are dropped).
+  void set_residual_uncertainty(double heading_bias_var_rad2, double scale_var);
+  /// Position measurement at t_ns (possibly before the last step: the steps after it are
+  /// taken off the prediction) through the windowed gate. `R` is its 2x2 covariance.
+  PositionUpdateResult update_position(TimeNs t_ns, const Eigen::Vector2d& z_en_m, const Eigen::Matrix2d& r_m2,
+                                       bool use_gate_policy = true);
+  /// Displacement since the clone (the last GNSS epoch), e.g. TDCP. Returns accepted.
+  bool update_displacement(TimeNs t_ns, TimeNs from_ns, const Eigen::Vector2d& d_en_m, const Eigen::Matrix2d& r_m2,
+                           double* nis = nullptr);
+  /// Clone the position at t_ns (a GNSS epoch) for the next displacement measurement.
+  void clone(TimeNs t_ns);
+  /// Account for the time since the last event (undetected motion).
+  void advance_to(TimeNs t_ns);
+
+  Eigen::Vector2d position_en_m() const { return x_.head<2>(); }
+  Eigen::Matrix2d position_cov_m2() const { return p_.topLeftCorner<2, 2>(); }
+  double heading_bias_rad() const { return x_(2); }
+  double scale_error() const { return x_(3); }
+  TimeNs t_ns() const { return t_ns_; }
+  TimeNs last_accepted_ns() const { return last_accept_ns_; }
+  TimeNs clone_t_ns() const { return clone_ok_ ? clone_t_ns_ : -1; }
+  const FusionFilterOptions& options() const { return opt_; }
+
+ private:
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  struct Recent { TimeNs t_ns; Eigen::Vector2d d_en_m; double var_m2; };
+  struct Held { TimeNs t_ns; Eigen::Vector2d z, nu; Eigen::Matrix2d r; };
+  /// Steps after t_ns: their displacement and variance.
+  void after(TimeNs t_ns, Eigen::Vector2d* d, double* var) const;
+  void apply_position(const Eigen::Vector2d& z, const Eigen::Matrix2d& r);
+  bool agree(const std::vector<Held>& h, Eigen::Vector2d* mean_nu) const;
+  void symmetrize();
+
+  FusionFilterOptions opt_;
+  bool initialized_ = false;
+  Vec6 x_ = Vec6::Zero();
+  Mat6 p_ = Mat6::Identity();
+  TimeNs t_ns_ = 0;
+  TimeNs last_step_ns_ = -1;
+  TimeNs last_accept_ns_ = -1;
+  bool clone_ok_ = false;
+  TimeNs clone_t_ns_ = 0;
+  std::deque<Recent> recent_;
+  std::vector<Held> rejected_;   // consecutive gate failures
+  std::vector<Held> reacq_;      // passes waiting for agreement after an outage
+};
+
+/// chi^2 quantile (Wilson-Hilferty), for the gates.
+double chi2_quantile(int dof, double p);
+
+}  // namespace pdnav::fusion

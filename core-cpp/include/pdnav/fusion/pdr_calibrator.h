@@ -1,0 +1,71 @@
+// PDR calibration from GNSS: step-length scale and heading bias over a sliding window, in the
+// style of Walker et al., Remote Sensing 2019, Sec. 3 (Eq. 9: the PDR step length and heading
+// are corrected from the GNSS track over a sliding window while GNSS is good). We solve the
+// window in closed form: with 2-D positions as complex numbers z = e + i n, a PDR track P_k
+// (integrated from the raw steps) and GNSS positions G_k satisfy G_k = a + c P_k + noise with
+// c = s exp(i b): s the step-length scale, b the heading bias (measured heading = true + b).
+// Weighted least squares gives c, its variance (inflated for time-correlated GNSS errors) and
+// so s, b with 1-sigma values (docs/fusion.md).
+#pragma once
+#include <complex>
+#include <cstdint>
+#include <deque>
+
+#include <Eigen/Core>
+
+#include "pdnav/geo/events.h"
+#include "pdnav/geo/units.h"
+
+namespace pdnav::fusion {
+
+struct PdrCalibrationOptions {
+  double window_s = 300.0;            // Walker 2019 Sec. 3: sliding window (5 min here)
+  double min_baseline_m = 20.0;       // RMS spread of the PDR track in the window before publishing
+  int min_epochs = 20;                // GNSS epochs in the window before publishing
+  double correlation_time_s = 10.0;   // GNSS error correlation (multipath): N_eff = span / this
+  double max_scale_sigma = 0.03;      // publish only when the scale is known to 3 %
+  double max_heading_bias_sigma_rad = 4.0 * kDegToRad;  // ... and the bias to 4 deg
+  double min_scale = 0.5, max_scale = 1.8;  // a fit outside is not a calibration (wrong data)
+  std::size_t max_steps_kept = 4096;  // bound on the step history (memory)
+};
+
+struct PdrCalibration {
+  bool valid = false;                 // published (passed the checks above)
+  TimeNs t_ns = 0;                    // time of the last GNSS epoch used
+  double scale = 1.0;                 // true step length = scale * PDR step length
+  double heading_bias_rad = 0.0;      // PDR heading = true heading + bias
+  double scale_sigma = 0.0;
+  double heading_bias_sigma_rad = 0.0;
+  int epochs = 0;                     // GNSS epochs in the window
+  double baseline_m = 0.0;            // RMS spread of the PDR track in the window
+};
+
+class PdrCalibrator {
+ public:
+  explicit PdrCalibrator(const PdrCalibrationOptions& opt = {}) : opt_(opt) {}
+  /// A raw (uncalibrated) PDR step; advances the integrated PDR track.
+  void add_step(const PdrStep& raw_step);
+  /// A GNSS position (local east/north, 1-sigma per axis) accepted by the fusion filter; it is
+  /// paired with the PDR track at the same time (steps after t_ns are not counted).
+  void add_gnss(TimeNs t_ns, const Eigen::Vector2d& en_m, double sigma_m);
+  /// Forget everything (e.g. the user changed the phone's placement).
+  void reset();
+  /// The latest fit (valid only once it passes the publication checks).
+  const PdrCalibration& calibration() const { return last_; }
+  /// The latest published calibration (kept through outages and until a better fit).
+  const PdrCalibration& published() const { return published_; }
+  const PdrCalibrationOptions& options() const { return opt_; }
+
+ private:
+  struct Pair { TimeNs t_ns; std::complex<double> p, g; double w; };
+  std::complex<double> pdr_at(TimeNs t_ns) const;
+  void fit();
+
+  PdrCalibrationOptions opt_;
+  std::complex<double> track_ = 0.0;                       // integrated raw PDR position
+  std::deque<std::pair<TimeNs, std::complex<double>>> steps_;  // (t, track after the step)
+  std::deque<Pair> window_;
+  PdrCalibration last_, published_;
+};
+
+}  // namespace pdnav::fusion

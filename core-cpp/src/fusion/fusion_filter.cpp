@@ -1,0 +1,272 @@
+#include "pdnav/fusion/fusion_filter.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+namespace pdnav::fusion {
+
+namespace {
+/// Upper-tail standard normal quantile, Abramowitz & Stegun 26.2.23 (|error| < 4.5e-4).
+double normal_quantile(double p) {
+  const double q = p < 0.5 ? p : 1.0 - p;
+  const double t = std::sqrt(-2.0 * std::log(q));
+  const double z = t - (2.515517 + 0.802853 * t + 0.010328 * t * t) / (1.0 + 1.432788 * t + 0.189269 * t * t + 0.001308 * t * t * t);
+  return p < 0.5 ? -z : z;
+}
+
+std::string fmt(double v, int prec = 1) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(prec);
+  s << v;
+  return s.str();
+}
+}  // namespace
+
+double chi2_quantile(int dof, double p) {
+  const double k = std::max(1, dof);
+  const double z = normal_quantile(p);
+  const double a = 2.0 / (9.0 * k);
+  const double v = 1.0 - a + z * std::sqrt(a);
+  return k * v * v * v;
+}
+
+void FusionFilter::initialize(const Eigen::Vector2d& en_m, double sigma_m, TimeNs t_ns) {
+  x_.setZero();
+  x_.head<2>() = en_m;
+  x_.tail<2>() = en_m;
+  p_.setZero();
+  const double v = sigma_m * sigma_m;
+  p_(0, 0) = p_(1, 1) = v;
+  p_(2, 2) = opt_.initial_heading_bias_sigma_rad * opt_.initial_heading_bias_sigma_rad;
+  p_(3, 3) = opt_.initial_scale_sigma * opt_.initial_scale_sigma;
+  p_.block<2, 2>(4, 4) = p_.block<2, 2>(0, 0);
+  p_.block<2, 2>(0, 4) = p_.block<2, 2>(0, 0);
+  p_.block<2, 2>(4, 0) = p_.block<2, 2>(0, 0);
+  t_ns_ = t_ns;
+  last_step_ns_ = t_ns;
+  clone_ok_ = false;
+  recent_.clear();
+  rejected_.clear();
+  reacq_.clear();
+  initialized_ = true;
+}
+
+void FusionFilter::symmetrize() { p_ = 0.5 * (p_ + p_.transpose()).eval(); }
+
+void FusionFilter::advance_to(TimeNs t_ns) {
+  if (!initialized_ || t_ns <= t_ns_) return;
+  // undetected motion: only the part of (t_ns_, t_ns] beyond undetected_after_s since the last step
+  const TimeNs quiet_from = last_step_ns_ + static_cast<TimeNs>(opt_.undetected_after_s * 1e9);
+  const TimeNs a = std::max(t_ns_, quiet_from);
+  if (t_ns > a) {
+    const double dt = static_cast<double>(t_ns - a) * 1e-9;
+    p_(0, 0) += opt_.undetected_motion_q_m2ps * dt;
+    p_(1, 1) += opt_.undetected_motion_q_m2ps * dt;
+  }
+  const double dt_all = static_cast<double>(t_ns - t_ns_) * 1e-9;
+  p_(2, 2) += opt_.heading_bias_rw_rad2ps * dt_all;
+  p_(3, 3) += opt_.scale_rw_1ps * dt_all;
+  t_ns_ = t_ns;
+}
+
+void FusionFilter::predict(const PdrStep& s) {
+  if (!initialized_ || !std::isfinite(s.length_m) || !std::isfinite(s.heading_rad)) return;
+  advance_to(s.t_ns);
+  const double psi = s.heading_rad - x_(2);
+  const double len = (1.0 + x_(3)) * s.length_m;
+  const double sp = std::sin(psi), cp = std::cos(psi);
+  const Eigen::Vector2d d(len * sp, len * cp);
+  Mat6 f = Mat6::Identity();
+  f(0, 2) = -len * cp;
+  f(1, 2) = len * sp;
+  f(0, 3) = s.length_m * sp;
+  f(1, 3) = s.length_m * cp;
+  const double sl = std::max(opt_.min_step_length_sigma_m, std::isfinite(s.length_sigma_m) ? s.length_sigma_m : 0.0);
+  const double sh = std::max(opt_.min_step_heading_sigma_rad,
+                             std::isfinite(s.heading_sigma_rad) ? s.heading_sigma_rad : 0.0);
+  Eigen::Matrix2d g;
+  g << sp, len * cp, cp, -len * sp;
+  const Eigen::Matrix2d q = g * Eigen::Vector2d(sl * sl, sh * sh).asDiagonal() * g.transpose();
+  x_.head<2>() += d;
+  p_ = (f * p_ * f.transpose()).eval();
+  p_.topLeftCorner<2, 2>() += q;
+  symmetrize();
+  last_step_ns_ = s.t_ns;
+  recent_.push_back({s.t_ns, d, q.trace() * 0.5});
+  while (recent_.size() > 64 || (!recent_.empty() && recent_.front().t_ns < s.t_ns - 30 * kNsPerS)) recent_.pop_front();
+}
+
+void FusionFilter::set_residual_uncertainty(double var_b, double var_s) {
+  if (!initialized_) return;
+  // fold the old residual estimate into nothing: the new calibration replaces it
+  x_(2) = 0.0;
+  x_(3) = 0.0;
+  for (int i = 0; i < 6; ++i) {
+    if (i == 2 || i == 3) continue;
+    p_(2, i) = p_(i, 2) = 0.0;
+    p_(3, i) = p_(i, 3) = 0.0;
+  }
+  p_(2, 3) = p_(3, 2) = 0.0;
+  p_(2, 2) = std::max(var_b, 1e-8);
+  p_(3, 3) = std::max(var_s, 1e-8);
+}
+
+void FusionFilter::after(TimeNs t_ns, Eigen::Vector2d* d, double* var) const {
+  d->setZero();
+  *var = 0.0;
+  for (const Recent& r : recent_)
+    if (r.t_ns > t_ns) {
+      *d += r.d_en_m;
+      *var += r.var_m2;
+    }
+}
+
+void FusionFilter::apply_position(const Eigen::Vector2d& z, const Eigen::Matrix2d& r) {
+  Eigen::Matrix<double, 2, 6> h = Eigen::Matrix<double, 2, 6>::Zero();
+  h(0, 0) = h(1, 1) = 1.0;
+  const Eigen::Matrix2d s = h * p_ * h.transpose() + r;
+  const Eigen::Matrix<double, 6, 2> k = p_ * h.transpose() * s.inverse();
+  x_ += k * (z - h * x_);
+  const Mat6 ikh = Mat6::Identity() - k * h;
+  p_ = (ikh * p_ * ikh.transpose() + k * r * k.transpose()).eval();  // Joseph form
+  symmetrize();
+}
+
+bool FusionFilter::agree(const std::vector<Held>& h, Eigen::Vector2d* mean_nu) const {
+  Eigen::Matrix2d w_sum = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d wz = Eigen::Vector2d::Zero();
+  for (const Held& x : h) {
+    const Eigen::Matrix2d w = x.r.inverse();
+    w_sum += w;
+    wz += w * x.nu;
+  }
+  const Eigen::Vector2d m = w_sum.inverse() * wz;
+  double chi2 = 0.0;
+  for (const Held& x : h) chi2 += (x.nu - m).dot(x.r.inverse() * (x.nu - m));
+  *mean_nu = m;
+  return chi2 <= chi2_quantile(2 * (static_cast<int>(h.size()) - 1), opt_.agreement_p);
+}
+
+PositionUpdateResult FusionFilter::update_position(TimeNs t_ns, const Eigen::Vector2d& z_en_m, const Eigen::Matrix2d& r_in,
+                                                   bool use_gate_policy) {
+  PositionUpdateResult res;
+  if (!initialized_ || !z_en_m.allFinite() || !r_in.allFinite() || !(r_in.determinant() > 0.0)) {
+    res.reason = "invalid measurement";
+    return res;
+  }
+  advance_to(t_ns);
+  Eigen::Vector2d d_after;
+  double var_after = 0.0;
+  after(t_ns, &d_after, &var_after);
+  const Eigen::Vector2d z = z_en_m + d_after;  // the measurement carried to the last step
+  const Eigen::Matrix2d r = r_in + var_after * Eigen::Matrix2d::Identity();
+  const Eigen::Vector2d nu = z - x_.head<2>();
+  const Eigen::Matrix2d s = p_.topLeftCorner<2, 2>() + r;
+  res.nis = nu.dot(s.inverse() * nu);
+  res.innovation_m = nu.norm();
+  if (!use_gate_policy) {
+    if (res.nis > opt_.gate_chi2) {
+      res.reason = "rejected: innovation " + fmt(res.innovation_m) + " m = " + fmt(std::sqrt(res.nis)) + " sigma";
+      return res;
+    }
+    apply_position(z, r);
+    res.accepted = true;
+    res.reason = "accepted";
+    return res;
+  }
+  const bool outage = last_accept_ns_ < 0 || t_ns - last_accept_ns_ > static_cast<TimeNs>(opt_.reacquire_after_s * 1e9);
+  const Held held{t_ns, z, nu, r};
+  if (res.nis <= opt_.gate_chi2) {
+    rejected_.clear();
+    if (outage && opt_.reacquire_epochs > 1) {
+      reacq_.push_back(held);
+      while (reacq_.size() > static_cast<std::size_t>(opt_.reacquire_epochs)) reacq_.erase(reacq_.begin());
+      Eigen::Vector2d m;
+      if (reacq_.size() < static_cast<std::size_t>(opt_.reacquire_epochs) || !agree(reacq_, &m)) {
+        res.reason = "re-acquisition: waiting for " + std::to_string(opt_.reacquire_epochs) + " agreeing epochs";
+        return res;
+      }
+      res.reacquired = true;
+      res.reason = std::string(last_accept_ns_ < 0 ? "acquired: " : "re-acquired: ") + std::to_string(reacq_.size()) + " agreeing epochs, offset " + fmt(m.norm()) + " m";
+      reacq_.clear();
+    } else {
+      res.reason = "accepted";
+    }
+    apply_position(z, r);
+    res.accepted = true;
+    last_accept_ns_ = t_ns;
+    return res;
+  }
+  // failed the gate: hold it; consistent disagreement over a window is a real correction
+  reacq_.clear();
+  rejected_.push_back(held);
+  const TimeNs win = static_cast<TimeNs>(opt_.confirm_window_s * 1e9);
+  while (!rejected_.empty() && rejected_.front().t_ns < t_ns - win) rejected_.erase(rejected_.begin());
+  while (rejected_.size() > static_cast<std::size_t>(opt_.confirm_epochs)) rejected_.erase(rejected_.begin());
+  Eigen::Vector2d m;
+  if (rejected_.size() >= static_cast<std::size_t>(opt_.confirm_epochs) && agree(rejected_, &m)) {
+    // the prediction, not GNSS, is wrong: widen the position covariance by the agreed offset
+    p_.topLeftCorner<2, 2>() += m * m.transpose();
+    p_.block<2, 2>(4, 4) += m * m.transpose();
+    apply_position(z, r);
+    res.accepted = true;
+    res.forced = true;
+    res.reacquired = outage;
+    res.reason = "GNSS disagreed consistently for " + std::to_string(rejected_.size()) + " epochs by " + fmt(m.norm()) +
+                 " m: accepted as a real correction";
+    rejected_.clear();
+    last_accept_ns_ = t_ns;
+    return res;
+  }
+  res.reason = "rejected: innovation " + fmt(res.innovation_m) + " m = " + fmt(std::sqrt(res.nis)) + " sigma (" +
+               std::to_string(rejected_.size()) + " in a row)";
+  return res;
+}
+
+bool FusionFilter::update_displacement(TimeNs t_ns, TimeNs from_ns, const Eigen::Vector2d& d_en_m, const Eigen::Matrix2d& r_in,
+                                       double* nis_out) {
+  if (!initialized_ || !clone_ok_ || std::llabs(from_ns - clone_t_ns_) > 50 * kNsPerMs || !d_en_m.allFinite() ||
+      !r_in.allFinite())
+    return false;
+  advance_to(t_ns);
+  Eigen::Vector2d d_after;
+  double var_after = 0.0;
+  after(t_ns, &d_after, &var_after);
+  const Eigen::Vector2d z = d_en_m + d_after;
+  const Eigen::Matrix2d r = r_in + var_after * Eigen::Matrix2d::Identity();
+  Eigen::Matrix<double, 2, 6> h = Eigen::Matrix<double, 2, 6>::Zero();
+  h(0, 0) = h(1, 1) = 1.0;
+  h(0, 4) = h(1, 5) = -1.0;
+  const Eigen::Vector2d nu = z - h * x_;
+  const Eigen::Matrix2d s = h * p_ * h.transpose() + r;
+  const double nis = nu.dot(s.inverse() * nu);
+  if (nis_out) *nis_out = nis;
+  if (nis > opt_.displacement_gate_chi2) return false;
+  const Eigen::Matrix<double, 6, 2> k = p_ * h.transpose() * s.inverse();
+  x_ += k * nu;
+  const Mat6 ikh = Mat6::Identity() - k * h;
+  p_ = (ikh * p_ * ikh.transpose() + k * r * k.transpose()).eval();
+  symmetrize();
+  return true;
+}
+
+void FusionFilter::clone(TimeNs t_ns) {
+  if (!initialized_) return;
+  Eigen::Vector2d d_after;
+  double var_after = 0.0;
+  after(t_ns, &d_after, &var_after);
+  // clone = position at t_ns = current - steps after t_ns (their noise is added on use)
+  x_.tail<2>() = x_.head<2>() - d_after;
+  p_.block<2, 6>(4, 0) = p_.block<2, 6>(0, 0);
+  p_.block<6, 2>(0, 4) = p_.block<6, 2>(0, 0);
+  p_.block<2, 2>(4, 4) = p_.block<2, 2>(0, 0);
+  clone_t_ns_ = t_ns;
+  clone_ok_ = true;
+}
+
+}  // namespace pdnav::fusion

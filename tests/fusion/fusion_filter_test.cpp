@@ -1,0 +1,126 @@
+// The fused filter's gate (issue 14): a multipath jump is rejected, a real correction accepted
+// after consistent disagreement, re-acquisition after an outage needs agreeing epochs, and
+// TDCP displacements are used. The walk and the GNSS errors here are not the filter's model:
+// the GNSS noise is uniform and the jump a constant offset.
+#include <cmath>
+#include <random>
+
+#include <Eigen/LU>
+#include <gtest/gtest.h>
+
+#include "pdnav/fusion/fusion_filter.h"
+
+namespace pdnav::fusion {
+namespace {
+
+struct Sim {
+  FusionFilter f;
+  std::mt19937_64 rng{5};
+  std::uniform_real_distribution<double> u{-1.0, 1.0};
+  Eigen::Vector2d truth = Eigen::Vector2d::Zero();
+  TimeNs t = 0;
+  Sim() { f.initialize(Eigen::Vector2d::Zero(), 3.0, 0); }
+  /// Walk one second east (2 steps); a GNSS epoch with `offset` on top of +-2 m uniform noise.
+  PositionUpdateResult second(const Eigen::Vector2d& offset, bool gnss = true) {
+    for (int k = 0; k < 2; ++k) {
+      t += 500 * kNsPerMs;
+      PdrStep s;
+      s.t_ns = t;
+      s.length_m = 0.7;
+      s.heading_rad = kPi / 2;
+      s.length_sigma_m = 0.05;
+      s.heading_sigma_rad = 0.05;
+      f.predict(s);
+      truth.x() += 0.7;
+    }
+    PositionUpdateResult r;
+    if (gnss) r = f.update_position(t, truth + offset + Eigen::Vector2d(2 * u(rng), 2 * u(rng)), 4.0 * Eigen::Matrix2d::Identity());
+    return r;
+  }
+};
+
+TEST(FusionFilter, MultipathJumpIsRejected) {
+  Sim s;
+  for (int k = 0; k < 60; ++k) s.second(Eigen::Vector2d::Zero());
+  const Eigen::Vector2d jump(40.0, -25.0);
+  for (int k = 0; k < 3; ++k) EXPECT_FALSE(s.second(jump).accepted) << k;  // 3 epochs of multipath
+  EXPECT_TRUE(s.second(Eigen::Vector2d::Zero()).accepted);
+  EXPECT_LT((s.f.position_en_m() - s.truth).norm(), 4.0);
+}
+
+TEST(FusionFilter, ConsistentDisagreementIsAcceptedAsARealCorrection) {
+  Sim s;
+  for (int k = 0; k < 60; ++k) s.second(Eigen::Vector2d::Zero());
+  // the filter is wrong by 30 m (e.g. a wrong start); GNSS is right from now on
+  s.truth += Eigen::Vector2d(0.0, 30.0);
+  int rejected = 0;
+  bool forced = false;
+  for (int k = 0; k < 10 && !forced; ++k) {
+    const PositionUpdateResult r = s.second(Eigen::Vector2d::Zero());
+    forced = r.forced;
+    rejected += r.accepted ? 0 : 1;
+  }
+  EXPECT_TRUE(forced);
+  EXPECT_EQ(rejected, s.f.options().confirm_epochs - 1);
+  for (int k = 0; k < 5; ++k) s.second(Eigen::Vector2d::Zero());
+  EXPECT_LT((s.f.position_en_m() - s.truth).norm(), 4.0);
+}
+
+TEST(FusionFilter, ReacquisitionAfterAnOutageNeedsAgreement) {
+  Sim s;
+  for (int k = 0; k < 30; ++k) s.second(Eigen::Vector2d::Zero());
+  for (int k = 0; k < 60; ++k) s.second(Eigen::Vector2d::Zero(), /*gnss=*/false);  // a 60 s outage
+  const PositionUpdateResult first = s.second(Eigen::Vector2d::Zero());
+  EXPECT_FALSE(first.accepted);
+  EXPECT_NE(first.reason.find("re-acquisition"), std::string::npos) << first.reason;
+  const PositionUpdateResult second = s.second(Eigen::Vector2d::Zero());
+  EXPECT_TRUE(second.accepted) << second.reason;
+  EXPECT_TRUE(second.reacquired);
+}
+
+TEST(FusionFilter, CovarianceGrowsInAnOutageAndShrinksWithGnss) {
+  Sim s;
+  for (int k = 0; k < 30; ++k) s.second(Eigen::Vector2d::Zero());
+  const double before = s.f.position_cov_m2().trace();
+  for (int k = 0; k < 120; ++k) s.second(Eigen::Vector2d::Zero(), false);
+  const double during = s.f.position_cov_m2().trace();
+  EXPECT_GT(during, 4.0 * before);
+  // the error after 2 min of dead reckoning is inside 3 sigma of the stated covariance
+  const Eigen::Vector2d err = s.f.position_en_m() - s.truth;
+  EXPECT_LT(err.dot(s.f.position_cov_m2().inverse() * err), 11.83);
+}
+
+TEST(FusionFilter, TdcpDisplacementCorrectsTheStepLength) {
+  // PDR says 0.7 m per step, the walker makes 0.8 m: TDCP displacements (no positions) pull the
+  // residual scale state towards +14 %
+  FusionFilter f;
+  f.initialize(Eigen::Vector2d::Zero(), 3.0, 0);
+  TimeNs t = 0;
+  double truth = 0.0;
+  f.clone(t);
+  for (int k = 0; k < 120; ++k) {
+    const TimeNs from = t;
+    for (int j = 0; j < 2; ++j) {
+      t += 500 * kNsPerMs;
+      PdrStep s;
+      s.t_ns = t;
+      s.length_m = 0.7;
+      s.heading_rad = 0.0;
+      s.length_sigma_m = 0.05;
+      s.heading_sigma_rad = 0.05;
+      f.predict(s);
+      truth += 0.8;
+    }
+    EXPECT_TRUE(f.update_displacement(t, from, Eigen::Vector2d(0.0, 1.6), 0.01 * Eigen::Matrix2d::Identity())) << k;
+    f.clone(t);
+  }
+  EXPECT_NEAR(f.scale_error(), 0.8 / 0.7 - 1.0, 0.02);
+}
+
+TEST(FusionFilter, Chi2QuantileMatchesTables) {
+  EXPECT_NEAR(chi2_quantile(2, 0.99), 9.21, 0.15);
+  EXPECT_NEAR(chi2_quantile(8, 0.99), 20.09, 0.2);
+}
+
+}  // namespace
+}  // namespace pdnav::fusion

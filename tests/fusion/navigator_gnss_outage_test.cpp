@@ -1,0 +1,120 @@
+// The fused estimate through a GNSS outage on the real Mountain View log (issue 14): a 60 s gap
+// cut into its Raw rows (and, in the harder variant, into its Fix rows too). Bars: no shown
+// jump above 3 sigma of the combined covariance of consecutive estimates, and after the gap
+// the error against the surveyed antenna position is no worse than GNSS alone.
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <Eigen/LU>
+#include <gtest/gtest.h>
+
+#include "pdnav/fusion/navigator.h"
+#include "pdnav/io/log_reader.h"
+#include "test_data.h"
+
+namespace pdnav::fusion {
+namespace {
+
+const geo::Geodetic kSurveyed = geo::Geodetic::from_deg(37.422578, -122.081678, -28.0);
+
+std::vector<Sample> read_log() {
+  io::LogReader log(test::shared_data("gnss-mountainview/pseudoranges_log_2016_08_22_14_45_50.txt"));
+  std::vector<Sample> out;
+  Sample s;
+  while (log.next(s)) out.push_back(s);
+  return out;
+}
+
+struct OutageRun {
+  double max_jump_sigma = 0.0;
+  double max_jump_m = 0.0;
+  double after_gap_mean_err_m = 0.0;  // shown estimate, epochs from the gap end to the log end
+  double gap_mean_err_m = 0.0;
+  int after_gap_epochs = 0;
+  std::vector<ModeChange> changes;
+};
+
+/// Replays the log with [gap_from, gap_to) cut (Raw rows; Fix rows too when cut_fix).
+OutageRun replay(const std::vector<Sample>& log, EngineMode mode, TimeNs gap_from, TimeNs gap_to, bool cut_fix) {
+  NavigatorConfig cfg;
+  cfg.mode = mode;
+  cfg.nav_paths.push_back(test::shared_data("gnss-mountainview/hour2350.16n"));
+  Navigator nav(cfg, 7);
+  const geo::LocalFrame truth(kSurveyed);
+  OutageRun r;
+  bool have_prev = false;
+  Estimate prev;
+  double sum_after = 0.0, sum_gap = 0.0;
+  int n_gap = 0;
+  for (const Sample& s : log) {
+    const TimeNs t = sample_time_ns(s);
+    const bool in_gap = t >= gap_from && t < gap_to;
+    if (in_gap && (std::holds_alternative<GnssRawSample>(s) || (cut_fix && std::holds_alternative<FixSample>(s)))) continue;
+    nav.feed(s);
+    const Estimate e = nav.estimate();
+    if (!e.valid() || (have_prev && e.t_ns == prev.t_ns)) continue;
+    const Eigen::Vector2d p = truth.to_enu(e.position).p_m.head<2>();
+    if (have_prev) {
+      const Eigen::Vector2d d = p - truth.to_enu(prev.position).p_m.head<2>();
+      const Eigen::Matrix2d c = e.cov_en_m2 + prev.cov_en_m2;
+      const double k = std::sqrt(d.dot(c.inverse() * d));
+      r.max_jump_sigma = std::max(r.max_jump_sigma, k);
+      r.max_jump_m = std::max(r.max_jump_m, d.norm());
+    }
+    if (e.t_ns >= gap_to) {
+      sum_after += p.norm();
+      ++r.after_gap_epochs;
+    } else if (e.t_ns >= gap_from) {
+      sum_gap += p.norm();
+      ++n_gap;
+    }
+    prev = e;
+    have_prev = true;
+  }
+  r.after_gap_mean_err_m = r.after_gap_epochs ? sum_after / r.after_gap_epochs : kNaN;
+  r.gap_mean_err_m = n_gap ? sum_gap / n_gap : kNaN;
+  r.changes = nav.mode_changes();
+  return r;
+}
+
+class MountainViewGap : public ::testing::TestWithParam<bool> {};
+
+TEST_P(MountainViewGap, NoShownJumpAbove3SigmaAndAfterTheGapNoWorseThanGnssAlone) {
+  const bool cut_fix = GetParam();
+  const std::vector<Sample> log = read_log();
+  TimeNs first_raw = -1;
+  for (const Sample& s : log)
+    if (std::holds_alternative<GnssRawSample>(s)) { first_raw = sample_time_ns(s); break; }
+  ASSERT_GE(first_raw, 0);
+  const TimeNs gap_from = first_raw + 90 * kNsPerS, gap_to = gap_from + 60 * kNsPerS;
+  const OutageRun fused = replay(log, EngineMode::kAuto, gap_from, gap_to, cut_fix);
+  const OutageRun gnss = replay(log, EngineMode::kGnss, gap_from, gap_to, cut_fix);
+  std::printf("cut_fix=%d fused: max jump %.2f sigma (%.1f m), gap err %.1f m, after-gap err %.2f m (%d epochs); "
+              "GNSS alone: max jump %.2f sigma (%.1f m), after-gap err %.2f m\n",
+              cut_fix, fused.max_jump_sigma, fused.max_jump_m, fused.gap_mean_err_m, fused.after_gap_mean_err_m,
+              fused.after_gap_epochs, gnss.max_jump_sigma, gnss.max_jump_m, gnss.after_gap_mean_err_m);
+  for (const ModeChange& c : fused.changes)
+    std::printf("  %.1f s %s -> %s: %s\n", static_cast<double>(c.t_ns - first_raw) * 1e-9, to_string(c.from), to_string(c.to),
+                c.reason.c_str());
+  ASSERT_GT(fused.after_gap_epochs, 30);
+  EXPECT_LE(fused.max_jump_sigma, 3.0);
+  EXPECT_LE(fused.after_gap_mean_err_m, gnss.after_gap_mean_err_m);
+  // the outage and the return are logged with reasons (a log without any sample in the gap
+  // tells the Navigator of the outage with its first sample after it)
+  bool lost = false, back = false;
+  for (const ModeChange& c : fused.changes) {
+    if (c.t_ns >= gap_from && c.to == FusionMode::kPdr) lost = c.reason.find("no usable GNSS for 6") != std::string::npos;
+    if (lost && c.t_ns >= gap_to - kNsPerS && c.to == FusionMode::kGnss) back = c.reason.find("re-acquired") != std::string::npos;
+  }
+  if (cut_fix) {
+    EXPECT_TRUE(lost) << "the outage is not in the mode log";
+    EXPECT_TRUE(back) << "the return of GNSS is not in the mode log";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(RawGapAndRawPlusFixGap, MountainViewGap, ::testing::Values(false, true));
+
+}  // namespace
+}  // namespace pdnav::fusion

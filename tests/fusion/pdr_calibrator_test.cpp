@@ -1,0 +1,98 @@
+// PDR calibration from GNSS (issue 14): after 5 minutes of open-sky GNSS on a simulated walk with
+// a known step-length scale and heading bias, the scale is within 2 % and the bias within 3 deg.
+// The simulation does not use the filter's error model: the heading bias is a constant plus
+// uniform (not Gaussian) per-step noise, the length error uniform, and the GNSS errors a sum of
+// slow sinusoids (multipath-like, time-correlated) plus Laplace noise.
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "pdnav/fusion/pdr_calibrator.h"
+
+namespace pdnav::fusion {
+namespace {
+
+struct Walk {
+  double true_scale = 1.07;            // true step = 1.07 x the PDR's step
+  double true_bias_rad = 6.0 * kDegToRad;  // PDR heading = true heading + 6 deg
+};
+
+PdrCalibration run(const Walk& w, double minutes, std::uint64_t seed, double multipath_m = 3.0) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::exponential_distribution<double> expo(1.0);
+  auto laplace = [&](double b) { return (u(rng) > 0 ? 1.0 : -1.0) * b * expo(rng); };
+  PdrCalibrator cal;
+  const TimeNs step_ns = 550 * kNsPerMs;
+  double heading = 0.3, e = 0.0, n = 0.0;
+  double next_turn_s = 30.0;
+  const double ph1 = u(rng) * kPi, ph2 = u(rng) * kPi;
+  TimeNs next_gnss = kNsPerS;
+  for (TimeNs t = 0; t < static_cast<TimeNs>(minutes * 60.0) * kNsPerS; t += step_ns) {
+    const double ts = static_cast<double>(t) * 1e-9;
+    if (ts > next_turn_s) {  // a turn of 40-140 deg either way every 20-60 s
+      heading += (u(rng) > 0 ? 1.0 : -1.0) * (40.0 + 50.0 * (u(rng) + 1.0)) * kDegToRad;
+      next_turn_s = ts + 40.0 + 20.0 * u(rng);
+    }
+    const double true_len = 0.75 * (1.0 + 0.05 * u(rng));
+    e += true_len * std::sin(heading);
+    n += true_len * std::cos(heading);
+    PdrStep s;
+    s.t_ns = t;
+    s.length_m = true_len / w.true_scale * (1.0 + 0.04 * u(rng));
+    s.heading_rad = heading + w.true_bias_rad + 8.0 * kDegToRad * u(rng);
+    cal.add_step(s);
+    while (next_gnss <= t) {
+      const double tg = static_cast<double>(next_gnss) * 1e-9;
+      const Eigen::Vector2d err(multipath_m * std::sin(2 * kPi * tg / 47.0 + ph1) + laplace(1.5),
+                                multipath_m * std::cos(2 * kPi * tg / 71.0 + ph2) + laplace(1.5));
+      cal.add_gnss(next_gnss, Eigen::Vector2d(e, n) + err, 4.0);
+      next_gnss += kNsPerS;
+    }
+  }
+  if (!cal.published().valid) {
+    const PdrCalibration& l = cal.calibration();
+    std::printf("last fit: epochs %d baseline %.1f scale %.4f +- %.4f bias %.2f +- %.2f deg\n", l.epochs, l.baseline_m, l.scale,
+                l.scale_sigma, l.heading_bias_rad / kDegToRad, l.heading_bias_sigma_rad / kDegToRad);
+  }
+  return cal.published();
+}
+
+TEST(PdrCalibrator, FiveMinutesOfOpenSkyGiveScaleWithin2PercentAndBiasWithin3Deg) {
+  const Walk w;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    const PdrCalibration c = run(w, 5.0, seed);
+    ASSERT_TRUE(c.valid) << "seed " << seed << ": epochs " << c.epochs << " baseline " << c.baseline_m;
+    EXPECT_NEAR(c.scale, w.true_scale, 0.02 * w.true_scale) << "seed " << seed;
+    EXPECT_NEAR(c.heading_bias_rad, w.true_bias_rad, 3.0 * kDegToRad) << "seed " << seed;
+    // the stated 1-sigma covers the error (3 sigma)
+    EXPECT_LT(std::abs(c.scale - w.true_scale), 3.0 * c.scale_sigma + 1e-3) << "seed " << seed;
+    EXPECT_LT(std::abs(c.heading_bias_rad - w.true_bias_rad), 3.0 * c.heading_bias_sigma_rad + 1e-3) << "seed " << seed;
+  }
+}
+
+TEST(PdrCalibrator, NegativeBiasAndShortStrideAreFoundToo) {
+  Walk w;
+  w.true_scale = 0.90;
+  w.true_bias_rad = -9.0 * kDegToRad;
+  const PdrCalibration c = run(w, 5.0, 42);
+  ASSERT_TRUE(c.valid);
+  EXPECT_NEAR(c.scale, w.true_scale, 0.02 * w.true_scale);
+  EXPECT_NEAR(c.heading_bias_rad, w.true_bias_rad, 3.0 * kDegToRad);
+}
+
+TEST(PdrCalibrator, NotPublishedBeforeEnoughBaseline) {
+  const PdrCalibration c = run(Walk{}, 0.25, 3);  // 15 s: ~20 m walked
+  EXPECT_FALSE(c.valid);
+}
+
+TEST(PdrCalibrator, StandingStillNeverPublishes) {
+  PdrCalibrator cal;
+  for (int k = 0; k < 600; ++k) cal.add_gnss(k * kNsPerS, Eigen::Vector2d(0.3 * std::sin(k), 0.2), 4.0);
+  EXPECT_FALSE(cal.published().valid);
+}
+
+}  // namespace
+}  // namespace pdnav::fusion
