@@ -53,6 +53,34 @@ fusion::NavigatorConfig make_config(const ReplayArgs& a) {
   return c;
 }
 
+/// The fused estimate's hand-overs, for the track CSV.
+std::vector<std::pair<TimeNs, std::string>> mode_change_notes(const fusion::Navigator& nav) {
+  std::vector<std::pair<TimeNs, std::string>> out;
+  for (const fusion::ModeChange& c : nav.mode_changes())
+    out.emplace_back(c.t_ns, std::string(fusion::to_string(c.from)) + " -> " + fusion::to_string(c.to) + ": " + c.reason);
+  return out;
+}
+
+/// summary.json "fusion": mode changes with reasons, counters, the PDR calibration in use.
+nlohmann::json fusion_summary(const fusion::Navigator& nav) {
+  nlohmann::json changes = nlohmann::json::array();
+  for (const fusion::ModeChange& c : nav.mode_changes())
+    changes.push_back({{"t_ns", c.t_ns}, {"from", fusion::to_string(c.from)}, {"to", fusion::to_string(c.to)}, {"reason", c.reason}});
+  nlohmann::json counts = nlohmann::json::object();
+  for (const auto& [k, v] : nav.fusion_counts()) counts[k] = v;
+  const fusion::NavigatorOutput o = nav.output(0);
+  const fusion::PdrCalibration& cal = o.calibration;
+  return {{"mode", fusion::to_string(o.mode)},
+          {"mode_change_count", o.mode_change_count},
+          {"mode_changes", changes},
+          {"counts", counts},
+          {"pdr_calibration",
+           {{"valid", cal.valid}, {"scale", cal.scale}, {"scale_sigma", cal.scale_sigma},
+            {"heading_bias_deg", rad_to_deg(cal.heading_bias_rad)},
+            {"heading_bias_sigma_deg", rad_to_deg(cal.heading_bias_sigma_rad)}, {"window_epochs", cal.epochs},
+            {"baseline_m", cal.baseline_m}}}};
+}
+
 int run_replay(const ReplayArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   std::filesystem::create_directories(a.out_dir);
@@ -69,6 +97,7 @@ int run_replay(const ReplayArgs& a) {
   }
   progress.done();
   rec.finish();
+  rec.set_mode_changes(mode_change_notes(nav));
   const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   const std::filesystem::path out(a.out_dir);
@@ -94,6 +123,7 @@ int run_replay(const ReplayArgs& a) {
   const ErrorStats st = rec.error_stats();
   if (st.n > 0) summary["errors"] = st.to_json();
   summary["reference"] = rec.reference_kind();
+  summary["fusion"] = fusion_summary(nav);
   std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
 
   std::cout << "log:      " << a.log << "\n"
@@ -101,6 +131,7 @@ int run_replay(const ReplayArgs& a) {
   for (const auto& [type, n] : reader.stats().samples_by_type) std::cout << "  " << type << ": " << n << "\n";
   for (const auto& [why, n] : reader.stats().skipped_by_reason) std::cout << "  skipped " << n << ": " << why << "\n";
   std::cout << "epochs:   " << rec.epochs().size() << "\n";
+  std::cout << "mode changes: " << nav.output(0).mode_change_count << " (summary.json fusion.mode_changes)\n";
   for (const auto& [eng, n] : rec.epochs_by_engine()) std::cout << "  " << eng << ": " << n << "\n";
   std::cout << "run time: " << run_s << " s\n"
             << "wrote:    " << (out / "track.csv").string() << ", track.geojson, summary.json\n";

@@ -174,8 +174,9 @@ void ReplayRecorder::write_track_csv(const std::string& path) const {
   std::ofstream f(path);
   if (!f) throw std::runtime_error(path + ": cannot create");
   f << "t_ns,engine,status,lat_deg,lon_deg,h_m,e_m,n_m,cov_ee_m2,cov_en_m2,cov_nn_m2,semi_major_m,semi_minor_m,"
-       "orientation_deg,ref_lat_deg,ref_lon_deg,err_e_m,err_n_m,reason\n";
+       "orientation_deg,ref_lat_deg,ref_lon_deg,err_e_m,err_n_m,reason,mode_change\n";
   f << std::setprecision(12);
+  std::size_t next_change = 0;
   for (const Epoch& ep : epochs_) {
     const Estimate& e = ep.est;
     const ErrorEllipse el = e.ellipse();
@@ -189,8 +190,23 @@ void ReplayRecorder::write_track_csv(const std::string& path) const {
       f << ",,,";
     std::string reason = e.reason;
     std::replace(reason.begin(), reason.end(), ',', ';');
-    f << ',' << reason << '\n';
+    f << ',' << reason << ',' << mode_changes_up_to(e.t_ns, &next_change) << '\n';
   }
+}
+
+void ReplayRecorder::set_mode_changes(std::vector<std::pair<TimeNs, std::string>> changes) {
+  std::stable_sort(changes.begin(), changes.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  mode_changes_ = std::move(changes);
+}
+
+std::string ReplayRecorder::mode_changes_up_to(TimeNs t_ns, std::size_t* next) const {
+  std::string out;
+  for (; *next < mode_changes_.size() && mode_changes_[*next].first <= t_ns; ++*next) {
+    if (!out.empty()) out += " | ";
+    out += mode_changes_[*next].second;
+  }
+  std::replace(out.begin(), out.end(), ',', ';');
+  return out;
 }
 
 std::vector<std::pair<double, double>> ellipse_polygon(const Estimate& e, double k, int points) {

@@ -68,8 +68,13 @@ class ReplayRecorder {
   std::string reference_kind() const;
   void write_track_csv(const std::string& path) const;
   void write_geojson(const std::string& path, std::size_t max_ellipses = 400) const;
+  /// Hand-overs of the fused estimate (time, "from -> to: reason"): the track CSV's last column
+  /// (mode_change) carries each one on the first epoch at or after its time.
+  void set_mode_changes(std::vector<std::pair<TimeNs, std::string>> changes);
 
  private:
+  std::vector<std::pair<TimeNs, std::string>> mode_changes_;
+  std::string mode_changes_up_to(TimeNs t_ns, std::size_t* next) const;
   struct Ref { TimeNs t_ns; geo::Geodetic p; };
   bool reference_at(TimeNs t, geo::Geodetic* out) const;
   std::vector<Ref> truth_;

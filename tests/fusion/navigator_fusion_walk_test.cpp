@@ -1,0 +1,149 @@
+// The Navigator's fused estimate on a simulated walk (issue 14): 5 minutes of chipset Fix rows,
+// then a 3 minute outage, then GNSS again. The phone's step length is 6 % short and its heading
+// 8 deg off (constant), with uniform per-step heading noise; the Fix errors are slow
+// sinusoids plus uniform noise (not the filter's Gaussian model). Bars: the calibration is
+// published and carried into the outage, the fused error at the end of the outage is at most
+// half of dead reckoning's from the outage start with the uncalibrated PDR, no shown jump is
+// above 3 sigma, and the mode log names the outage and the return.
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <gtest/gtest.h>
+
+#include "pdnav/fusion/navigator.h"
+
+namespace pdnav::fusion {
+namespace {
+
+MetaSample meta(TimeNs t, const std::string& key, const std::string& value) {
+  MetaSample m;
+  m.t_ns = t;
+  m.key = key;
+  m.value = value;
+  return m;
+}
+
+struct WalkResult {
+  double fused_err_end_outage_m = 0.0, dr_err_end_outage_m = 0.0, fused_err_after_m = 0.0;
+  double max_jump_sigma = 0.0;
+  PdrCalibration cal;
+  std::vector<ModeChange> changes;
+};
+
+WalkResult walk(std::uint64_t seed, double outage_s = 180.0) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  NavigatorConfig cfg;  // kAuto: the fused estimate
+  Navigator nav(cfg, seed);
+  TimeNs t = kNsPerS;
+  nav.feed(meta(t, "StartLatitudeDegrees", "42.5"));
+  nav.feed(meta(t, "StartLongitudeDegrees", "1.5"));
+  nav.feed(meta(t, "StartSigmaMeters", "5"));
+  const double model_len = 0.415 * kDefaultUserHeightM;  // what the PDR reports
+  const double true_len = model_len * 1.06;
+  const double bias = 8.0 * kDegToRad;                   // the phone's heading error
+  Eigen::Matrix3d r0;
+  r0.col(0) = Eigen::Vector3d(1, 0, 0);
+  r0.col(1) = Eigen::Vector3d(0, 0, 1);
+  r0.col(2) = Eigen::Vector3d(0, -1, 0);
+  const geo::LocalFrame frame(geo::Geodetic::from_deg(42.5, 1.5, 0.0));
+  Eigen::Vector2d truth = Eigen::Vector2d::Zero();
+  double heading = 0.4, next_turn_s = 40.0;
+  const double open_s = 300.0, end_s = open_s + outage_s + 60.0;
+  TimeNs next_fix = 2 * kNsPerS;
+  WalkResult res;
+  Estimate prev;
+  bool have_prev = false;
+  Eigen::Vector2d dr_at_outage = Eigen::Vector2d::Zero(), truth_at_outage = Eigen::Vector2d::Zero();
+  const double ph = u(rng) * kPi;
+  double sum_after = 0.0;
+  int n_after = 0;
+  while (static_cast<double>(t) * 1e-9 < end_s) {
+    t += 550 * kNsPerMs;
+    const double ts = static_cast<double>(t) * 1e-9;
+    if (ts > next_turn_s) {
+      heading += (u(rng) > 0 ? 1.0 : -1.0) * (60.0 + 30.0 * u(rng)) * kDegToRad;
+      next_turn_s = ts + 45.0 + 15.0 * u(rng);
+    }
+    truth += true_len * Eigen::Vector2d(std::sin(heading), std::cos(heading));
+    const double shown_heading = heading + bias + 4.0 * kDegToRad * u(rng);
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(-shown_heading, Eigen::Vector3d::UnitZ()).toRotationMatrix() * r0);
+    RotationVectorSample rv;
+    rv.t_ns = t - kNsPerMs;
+    rv.quat_xyzw = Eigen::Vector4d(q.x(), q.y(), q.z(), q.w());
+    rv.heading_accuracy_rad = 0.1;
+    nav.feed(rv);
+    StepDetectorSample sd;
+    sd.t_ns = t;
+    nav.feed(sd);
+    const bool outage = ts >= open_s && ts < open_s + outage_s;
+    while (next_fix <= t) {
+      const double tf = static_cast<double>(next_fix) * 1e-9;
+      if (!outage) {
+        const Eigen::Vector2d err(2.0 * std::sin(2 * kPi * tf / 53.0 + ph) + 2.0 * u(rng), 2.0 * std::cos(2 * kPi * tf / 67.0) + 2.0 * u(rng));
+        const geo::Geodetic g = frame.to_geodetic(geo::Enu(truth.x() + err.x(), truth.y() + err.y(), 0.0));
+        FixSample f;
+        f.t_ns = next_fix;
+        f.provider = "GPS";
+        f.lat_deg = g.lat_deg();
+        f.lon_deg = g.lon_deg();
+        f.alt_m = 0.0;
+        f.accuracy_m = 4.0;
+        nav.feed(f);
+      }
+      next_fix += kNsPerS;
+    }
+    const NavigatorOutput o = nav.output(0);
+    const Estimate& e = o.estimate;
+    const Eigen::Vector2d p = frame.to_enu(e.position).p_m.head<2>();
+    const Eigen::Vector2d dr = frame.to_enu(o.engines.front().position).p_m.head<2>();  // raw dead reckoning
+    if (have_prev) {
+      const Eigen::Vector2d d = p - frame.to_enu(prev.position).p_m.head<2>();
+      res.max_jump_sigma = std::max(res.max_jump_sigma, std::sqrt(d.dot((e.cov_en_m2 + prev.cov_en_m2).inverse() * d)));
+    }
+    prev = e;
+    have_prev = true;
+    if (ts < open_s) {
+      dr_at_outage = dr;
+      truth_at_outage = truth;
+      res.cal = o.calibration;
+    } else if (outage) {
+      res.fused_err_end_outage_m = (p - truth).norm();
+      res.dr_err_end_outage_m = (truth_at_outage + (dr - dr_at_outage) - truth).norm();
+    } else if (ts > open_s + outage_s + 10.0) {
+      sum_after += (p - truth).norm();
+      ++n_after;
+    }
+  }
+  res.fused_err_after_m = n_after ? sum_after / n_after : kNaN;
+  res.changes = nav.mode_changes();
+  return res;
+}
+
+TEST(NavigatorFusionWalk, CalibratedPdrCarriesThroughA3MinuteOutageWithoutJumps) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const WalkResult r = walk(seed);
+    std::printf("seed %d: calibration %s scale %.3f bias %.1f deg; end of outage: fused %.1f m, DR from the outage start "
+                "%.1f m (ratio %.2f); after: %.1f m; max jump %.2f sigma\n",
+                static_cast<int>(seed), r.cal.valid ? "valid" : "INVALID", r.cal.scale, rad_to_deg(r.cal.heading_bias_rad),
+                r.fused_err_end_outage_m, r.dr_err_end_outage_m, r.fused_err_end_outage_m / r.dr_err_end_outage_m,
+                r.fused_err_after_m, r.max_jump_sigma);
+    ASSERT_TRUE(r.cal.valid) << seed;
+    EXPECT_NEAR(r.cal.scale, 1.06, 0.02 * 1.06) << seed;
+    EXPECT_LE(r.fused_err_end_outage_m, 0.5 * r.dr_err_end_outage_m) << seed;
+    EXPECT_LE(r.max_jump_sigma, 3.0) << seed;
+    EXPECT_LT(r.fused_err_after_m, 6.0) << seed;
+    bool lost = false, back = false;
+    for (const ModeChange& c : r.changes) {
+      if (c.to == FusionMode::kPdr && c.reason.find("calibrated PDR") != std::string::npos) lost = true;
+      if (lost && c.to != FusionMode::kPdr && c.reason.find("re-acquired") != std::string::npos) back = true;
+    }
+    EXPECT_TRUE(lost && back) << seed;
+  }
+}
+
+}  // namespace
+}  // namespace pdnav::fusion
