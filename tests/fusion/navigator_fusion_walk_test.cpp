@@ -33,13 +33,13 @@ struct WalkResult {
   std::vector<ModeChange> changes;
 };
 
-WalkResult walk(std::uint64_t seed, double outage_s = 180.0) {
+WalkResult walk(std::uint64_t seed, double outage_s = 180.0, double start_off_m = 0.0) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   NavigatorConfig cfg;  // kAuto: the fused estimate
   Navigator nav(cfg, seed);
   TimeNs t = kNsPerS;
-  nav.feed(meta(t, "StartLatitudeDegrees", "42.5"));
+  nav.feed(meta(t, "StartLatitudeDegrees", std::to_string(42.5 + start_off_m / 111132.0)));
   nav.feed(meta(t, "StartLongitudeDegrees", "1.5"));
   nav.feed(meta(t, "StartSigmaMeters", "5"));
   const double model_len = 0.415 * kDefaultUserHeightM;  // what the PDR reports
@@ -143,6 +143,18 @@ TEST(NavigatorFusionWalk, CalibratedPdrCarriesThroughA3MinuteOutageWithoutJumps)
     }
     EXPECT_TRUE(lost && back) << seed;
   }
+}
+
+TEST(NavigatorFusionWalk, AWrongStartIsCorrectedByGnssWithoutAShownJump) {
+  // declared 40 m north of where the walk starts, with a 5 m sigma: GNSS disagrees consistently,
+  // is accepted as a real correction, and the shown position is blended over
+  const WalkResult r = walk(4, 60.0, 40.0);
+  std::printf("wrong start: max jump %.2f sigma, error after %.1f m\n", r.max_jump_sigma, r.fused_err_after_m);
+  EXPECT_LE(r.max_jump_sigma, 3.0);
+  EXPECT_LT(r.fused_err_after_m, 6.0);
+  bool forced = false;
+  for (const ModeChange& c : r.changes) forced = forced || c.reason.find("real correction") != std::string::npos;
+  EXPECT_TRUE(forced);
 }
 
 }  // namespace
