@@ -135,6 +135,17 @@ void FusionFilter::apply_position(const Eigen::Vector2d& z, const Eigen::Matrix2
   const Mat6 ikh = Mat6::Identity() - k * h;
   p_ = (ikh * p_ * ikh.transpose() + k * r * k.transpose()).eval();  // Joseph form
   symmetrize();
+  // correlated-error floor: smallest eigenvalue of P_pos >= fraction x the smallest of R
+  const Eigen::Matrix2d pp = p_.topLeftCorner<2, 2>();
+  const double tr = pp.trace(), det = pp.determinant();
+  const double lmin = 0.5 * tr - std::sqrt(std::max(0.0, 0.25 * tr * tr - det));
+  const double rtr = r.trace(), rdet = r.determinant();
+  const double rmin = 0.5 * rtr - std::sqrt(std::max(0.0, 0.25 * rtr * rtr - rdet));
+  const double floor = opt_.position_floor_fraction * rmin;
+  if (lmin < floor) {
+    p_(0, 0) += floor - lmin;
+    p_(1, 1) += floor - lmin;
+  }
 }
 
 bool FusionFilter::agree(const std::vector<Held>& h, Eigen::Vector2d* mean_nu) const {

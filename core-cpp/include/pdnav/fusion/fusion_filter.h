@@ -44,6 +44,10 @@ struct FusionFilterOptions {
   double reacquire_after_s = 30.0;   // no accepted position this long = an outage
   int reacquire_epochs = 2;          // after an outage, this many agreeing epochs before use
   double displacement_gate_chi2 = 13.82;  // TDCP / Doppler: chi^2(2) at 99.9 % (cycle slips)
+  /// Phone code errors are time-correlated (multipath, minutes): after a position update the
+  /// position variance is kept >= this fraction of the measurement's, so a run of correlated
+  /// fixes never claims they averaged out (beyond the paper; docs/fusion.md). 0 = off.
+  double position_floor_fraction = 0.25;
 };
 
 struct PositionUpdateResult {
