@@ -220,6 +220,26 @@ jobjectArray nav_ignored(JNIEnv* env, jclass, jlong handle) {
   });
 }
 
+// Fused-estimate hand-overs (issue 14), flat: t_ns, from, to, reason, t_ns, from, ...
+jobjectArray nav_mode_changes(JNIEnv* env, jclass, jlong handle) {
+  return guarded<jobjectArray>(env, nullptr, [&] {
+    auto& h = from_handle<fusion::Navigator>(handle, "NativeNavigator");
+    std::vector<fusion::ModeChange> changes;
+    {
+      const std::lock_guard<std::mutex> lock(h.mutex);
+      changes = h.object.mode_changes();
+    }
+    std::vector<std::string> flat;
+    for (const fusion::ModeChange& c : changes) {
+      flat.push_back(std::to_string(c.t_ns));
+      flat.push_back(fusion::to_string(c.from));
+      flat.push_back(fusion::to_string(c.to));
+      flat.push_back(c.reason);
+    }
+    return names(env, flat);
+  });
+}
+
 void nav_close(JNIEnv* env, jclass, jlong handle) {
   guarded_void(env, [&] {
     auto* h = &from_handle<fusion::Navigator>(handle, "NativeNavigator");
@@ -351,6 +371,7 @@ const JNINativeMethod kMethods[] = {
     {const_cast<char*>("navEstimate"), const_cast<char*>("(J)Lorg/pdnav/app/nav/NavEstimate;"), reinterpret_cast<void*>(&nav_estimate)},
     {const_cast<char*>("navOutput"), const_cast<char*>("(JI)Lorg/pdnav/app/nav/NavOutput;"), reinterpret_cast<void*>(&nav_output)},
     {const_cast<char*>("navIgnored"), const_cast<char*>("(J)[Ljava/lang/String;"), reinterpret_cast<void*>(&nav_ignored)},
+    {const_cast<char*>("navModeChanges"), const_cast<char*>("(J)[Ljava/lang/String;"), reinterpret_cast<void*>(&nav_mode_changes)},
     {const_cast<char*>("navClose"), const_cast<char*>("(J)V"), reinterpret_cast<void*>(&nav_close)},
     {const_cast<char*>("recOpen"), const_cast<char*>("(Ljava/lang/String;Ljava/lang/String;JZ)J"), reinterpret_cast<void*>(&rec_open)},
     {const_cast<char*>("recWrite"), const_cast<char*>("(J" PDNAV_BATCH_SIG ")V"), reinterpret_cast<void*>(&rec_write)},

@@ -40,6 +40,8 @@ object NativeBridge {
     @JvmStatic external fun navEstimate(handle: Long): NavEstimate
     @JvmStatic external fun navOutput(handle: Long, maxParticles: Int): NavOutput
     @JvmStatic external fun navIgnored(handle: Long): Array<String>
+    /** Fused-estimate hand-overs, flat: tNs, from, to, reason, ... */
+    @JvmStatic external fun navModeChanges(handle: Long): Array<String>
     @JvmStatic external fun navClose(handle: Long)
 
     @JvmStatic external fun recOpen(path: String?, device: String?, flushIntervalNs: Long, fsync: Boolean): Long

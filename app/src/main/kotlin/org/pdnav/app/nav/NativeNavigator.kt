@@ -41,9 +41,18 @@ class NativeNavigator(config: NavigatorConfig, seed: Long) : AutoCloseable, Samp
         (flat.indices step 2).associate { flat[it] to flat[it + 1].toLong() }
     }
 
+    /** Hand-overs of the fused estimate ("gnss", "gnss-degraded", "route", "terrain", "pdr"), with reasons. */
+    fun modeChanges(): List<ModeChange> = synchronized(lock) {
+        val flat = NativeBridge.navModeChanges(handle)
+        (flat.indices step 4).map { ModeChange(flat[it].toLong(), flat[it + 1], flat[it + 2], flat[it + 3]) }
+    }
+
     override fun close() = synchronized(lock) {
         val h = handle
         handle = 0L
         if (h != 0L) NativeBridge.navClose(h)
     }
 }
+
+/** One hand-over of the fused estimate (core: fusion::ModeChange). */
+data class ModeChange(val tNs: Long, val from: String, val to: String, val reason: String)
