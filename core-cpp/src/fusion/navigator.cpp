@@ -613,6 +613,7 @@ struct Navigator::Impl {
   }
 
   void update_shown(TimeNs t) {
+    if (shown_valid) t = std::max(t, shown_t_ns);  // a late epoch never moves the shown time back
     const Eigen::Vector2d m = ff.position_en_m();
     const Eigen::Matrix2d p = ff.position_cov_m2();
     if (!shown_valid) {
