@@ -118,3 +118,74 @@ INSTANTIATE_TEST_SUITE_P(RawGapAndRawPlusFixGap, MountainViewGap, ::testing::Val
 
 }  // namespace
 }  // namespace pdnav::fusion
+
+namespace pdnav::fusion {
+namespace {
+
+struct ThinnedRun {
+  int epochs = 0, gnss_mode_epochs = 0, degraded_epochs = 0;
+  double mean_err_m = 0.0;
+  TimeNs max_lag_ns = 0;  // shown time behind the last Raw row fed, at each Raw epoch's completion
+};
+
+/// The Mountain View log thinned: every `keep_every`-th Raw epoch (duty cycling), and at most
+/// `max_sats` GPS rows per epoch (a degraded sky); Fix rows dropped (Raw only).
+ThinnedRun thinned(int keep_every, int max_sats) {
+  const std::vector<Sample> log = read_log();
+  NavigatorConfig cfg;
+  cfg.nav_paths.push_back(test::shared_data("gnss-mountainview/hour2350.16n"));
+  Navigator nav(cfg, 3);
+  const geo::LocalFrame truth(kSurveyed);
+  ThinnedRun r;
+  std::int64_t epoch_time = kMissingInt;
+  int epoch_index = -1, rows_in_epoch = 0;
+  double sum = 0.0;
+  TimeNs last_t = -1;
+  for (const Sample& s : log) {
+    if (std::holds_alternative<FixSample>(s)) continue;
+    if (const auto* raw = std::get_if<GnssRawSample>(&s)) {
+      if (raw->time_nanos != epoch_time) {
+        epoch_time = raw->time_nanos;
+        ++epoch_index;
+        rows_in_epoch = 0;
+      }
+      if (epoch_index % keep_every != 0) continue;
+      // the log's navigation file is GPS only: count (and keep) GPS rows (CONSTELLATION_GPS = 1)
+      if (max_sats < 1000 && (raw->constellation_type != 1 || ++rows_in_epoch > max_sats)) continue;
+    }
+    nav.feed(s);
+    const Estimate e = nav.estimate();
+    if (!e.valid() || e.t_ns == last_t) continue;
+    last_t = e.t_ns;
+    ++r.epochs;
+    r.gnss_mode_epochs += e.engine == EngineKind::kGnss ? 1 : 0;
+    r.degraded_epochs += e.reason.rfind("fused (gnss-degraded)", 0) == 0 ? 1 : 0;
+    sum += truth.to_enu(e.position).p_m.head<2>().norm();
+  }
+  r.mean_err_m = r.epochs ? sum / r.epochs : kNaN;
+  if (r.epochs == 0)
+    for (const Estimate& e : nav.output(0).engines) std::printf("  engine %s: %s\n", to_string(e.engine), e.reason.c_str());
+  return r;
+}
+
+TEST(NavigatorDutyCycledGnss, EpochsEighteenSecondsApartKeepTheGnssMode) {
+  const ThinnedRun r = thinned(18, 1000);
+  std::printf("duty-cycled (1 epoch in 18): %d shown epochs, %d in a GNSS mode, mean error %.1f m\n", r.epochs,
+              r.gnss_mode_epochs, r.mean_err_m);
+  ASSERT_GE(r.epochs, 8);
+  EXPECT_GE(r.gnss_mode_epochs, r.epochs - 2);  // all but the start
+  EXPECT_LT(r.mean_err_m, 15.0);
+}
+
+TEST(NavigatorDutyCycledGnss, FewerThanSixUsedSatellitesStillFeedTheFilterAsDegraded) {
+  // 6 GPS rows per epoch, of which the engine uses fewer than 6 in most epochs (exclusions)
+  const ThinnedRun r = thinned(1, 6);
+  std::printf("6 GPS rows: %d shown epochs, %d in a GNSS mode (%d degraded), mean error %.1f m\n", r.epochs,
+              r.gnss_mode_epochs, r.degraded_epochs, r.mean_err_m);
+  ASSERT_GE(r.epochs, 50);
+  EXPECT_GE(r.degraded_epochs, r.epochs / 2);
+  EXPECT_LT(r.mean_err_m, 30.0);
+}
+
+}  // namespace
+}  // namespace pdnav::fusion

@@ -124,6 +124,7 @@ struct Navigator::Impl {
   TimeNs last_gnss_ns = -1;               // last accepted GNSS (Raw or Fix) position
   TimeNs last_raw_pos_ns = -1;            // last Raw epoch with an SPP position (accepted or not)
   double gnss_interval_s = 1.0;           // typical interval between accepted GNSS positions
+  int gnss_intervals = 0;
   bool gnss_degraded = false;             // the last accepted one was degraded / Fix-only
   std::string gnss_what;                  // description of the last accepted GNSS measurement
   std::string last_event;                 // the last notable filter event (for the reason)
@@ -260,7 +261,8 @@ struct Navigator::Impl {
     if (!gnss) return;
     std::vector<gnss::EpochSolution> sols = gnss->take_solutions();
     const Estimate g = gnss->estimate();
-    if (g.status == EstimateStatus::kOk) {
+    // the fused estimate also starts from a degraded (< 6 satellites) fix, with its covariance
+    if (g.status == EstimateStatus::kOk || (fused && !started && g.status == EstimateStatus::kDegraded)) {
       last_gnss_ok_ns = g.t_ns;
       if (!started) {
         pending_start_lat = g.position.lat_deg();
@@ -424,7 +426,7 @@ struct Navigator::Impl {
   void accepted_gnss(TimeNs t, const Eigen::Vector2d& z, double sigma_m, bool degraded, const std::string& what) {
     if (last_gnss_ns >= 0) {
       const double dt = static_cast<double>(t - last_gnss_ns) * 1e-9;
-      if (dt > 0.0 && dt < 60.0) gnss_interval_s = 0.8 * gnss_interval_s + 0.2 * dt;
+      if (dt > 0.0 && dt < 60.0) gnss_interval_s = gnss_intervals++ == 0 ? dt : 0.8 * gnss_interval_s + 0.2 * dt;
     }
     last_gnss_ns = t;
     gnss_degraded = degraded;
