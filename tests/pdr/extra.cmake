@@ -41,6 +41,6 @@ foreach(_args "NOSUCH" "NOSUCH --help" "eval-nosuch --dem x.pdem")
   set_tests_properties("${_name}" PROPERTIES LABELS "cli")
 endforeach()
 add_test(NAME steps_cli_eval_terrain_hgt_zip
-         COMMAND sh -c "out=$(\"$0\" eval-terrain --dem \"$1\" --walks 1 2>&1); rc=$?; echo \"rc=$rc $out\"; [ $rc -ne 0 ] && echo \"$out\" | grep -qF \"dem-tools/pdnav_dem.py tile /vsizip/$1/N42E001.hgt -o N42E001.pdem --bbox 42 1 43 2\""
+         COMMAND sh -c "out=$(\"$0\" eval-terrain --dem \"$1\" --walks 1 2>&1); rc=$?; echo \"rc=$rc $out\"; [ $rc -ne 0 ] && echo \"$out\" | grep -qF \"dem-tools/pdnav_dem.py tile /vsizip/$1/N42E001.hgt -o N42E001.pdem --center 42.5 1.5 --radius 36000\""
                  $<TARGET_FILE:pdnav> "${PDNAV_SHARED_DATA_DIR}/terrain-andorra/N42E001.hgt.zip")
 set_tests_properties(steps_cli_eval_terrain_hgt_zip PROPERTIES LABELS "terrain;cli")

@@ -1,6 +1,9 @@
 // .pdem reader (docs/dem-format.md) and bilinear lookups.
 #include "pdnav/terrain/dem.h"
 
+#include "pdnav/geo/units.h"
+
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -41,9 +44,15 @@ std::string not_pdem_message(const std::string& name) {
                     (ns == 'N' || ns == 'S') && (ew == 'E' || ew == 'W');
   msg += "; make one with: dem-tools/pdnav_dem.py tile " + gdal_path + " -o " + tile + ".pdem";
   if (srtm) {
+    // The tile's centre and the largest square (in metres) that stays inside the one-degree
+    // tile at its poleward edge, with a 10 % margin (the tool refuses an area partly outside).
     const int s = ns == 'N' ? lat : -lat, w = ew == 'E' ? lon : -lon;
-    msg += " --bbox " + std::to_string(s) + " " + std::to_string(w) + " " + std::to_string(s + 1) + " " +
-           std::to_string(w + 1) + " --cell 30 --fill-voids";
+    const double poleward_rad = std::max(std::abs(s), std::abs(s + 1)) * pdnav::kDegToRad;
+    constexpr double kMetresPerDegree = 111320.0;
+    const double radius_m = 0.45 * kMetresPerDegree * std::min(1.0, std::cos(poleward_rad));
+    char area[96];
+    std::snprintf(area, sizeof area, " --center %.1f %.1f --radius %.0f", s + 0.5, w + 0.5, 1000.0 * std::floor(radius_m / 1000.0));
+    msg += std::string(area) + " --cell 30 --fill-voids";
   } else {
     msg += " --center LAT LON --radius METRES";
   }
