@@ -7,6 +7,8 @@
 #include <cmath>
 #include <memory>
 #include <type_traits>
+#include <utility>
+#include <variant>
 #include <cstdio>
 #include <iostream>
 #include <stdexcept>
@@ -15,6 +17,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "pdnav/geo/wmm.h"
 #include "pdnav/io/log_reader.h"
 #include "pdnav/pdr/pdr.h"
 #include "support/pdr_oxford.h"
@@ -46,7 +49,65 @@ struct FileResult {
   pdr::StepConsistency consistency;
   std::vector<PdrTurn> turns;
   std::vector<PdrStep> steps;
+  std::string heading_frame;  // how the headings are referenced (true north via WMM, or magnetic)
 };
+
+/// Issue 19.4: the log's Meta start (StartLatitudeDegrees/StartLongitudeDegrees) and its first
+/// UTC time give the WMM declination; without a start the headings stay magnetic, and say so.
+struct MetaStart {
+  double lat_deg = kNaN, lon_deg = kNaN;
+  std::int64_t utc_ms = kMissingInt;
+  bool applied = false;
+  std::int64_t applied_utc_ms = kMissingInt;
+
+  void note(const Sample& s) {
+    if (const auto* m = std::get_if<MetaSample>(&s)) {
+      try {
+        if (m->key == "StartLatitudeDegrees") lat_deg = std::stod(m->value);
+        if (m->key == "StartLongitudeDegrees") lon_deg = std::stod(m->value);
+      } catch (const std::exception&) {
+        std::cerr << "Meta " << m->key << ": not a number ('" << m->value << "'), ignored\n";
+      }
+    }
+    if (utc_ms == kMissingInt) {
+      std::visit(
+          [&](const auto& x) {
+            if constexpr (has_utc_field<std::decay_t<decltype(x)>>::value)
+              if (x.utc_ms != kMissingInt && x.utc_ms > 0) utc_ms = x.utc_ms;
+          },
+          s);
+    }
+  }
+  bool valid() const {
+    return std::isfinite(lat_deg) && std::isfinite(lon_deg) && std::abs(lat_deg) <= 90.0 && std::abs(lon_deg) <= 180.0;
+  }
+  /// Tells the engine (again when the UTC time arrives after the start).
+  void apply(pdr::Pdr& engine) {
+    if (!valid() || (applied && applied_utc_ms == utc_ms)) return;
+    engine.set_location(geo::Geodetic::from_deg(lat_deg, lon_deg, 0.0), utc_ms);
+    applied = true;
+    applied_utc_ms = utc_ms;
+  }
+
+  template <typename T, typename = void>
+  struct has_utc_field : std::false_type {};
+  template <typename T>
+  struct has_utc_field<T, std::void_t<decltype(std::declval<T>().utc_ms)>> : std::true_type {};
+};
+
+std::string describe_frame(const pdr::Pdr& engine, const MetaStart& start) {
+  if (!engine.has_location()) {
+    return "headings are MAGNETIC (no declination applied: the log has no Meta StartLatitudeDegrees/"
+           "StartLongitudeDegrees)";
+  }
+  const geo::Declination& d = engine.declination();
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "headings are true north: declination %+.2f deg (%s, %.2f) at the log's Meta start %.5f, %.5f",
+                rad_to_deg(d.declination_rad), d.model.c_str(), d.decimal_year, start.lat_deg, start.lon_deg);
+  std::string out = buf;
+  if (!d.warning.empty()) out += "; warning: " + d.warning;
+  return out;
+}
 
 std::string base_name(const std::string& path) {
   const auto pos = path.find_last_of('/');
@@ -75,15 +136,21 @@ FileResult run_log(const std::string& path, const pdr::PdrOptions& options) {
   Sample s;
   TimeNs t0 = 0, t1 = 0;
   bool first = true;
+  MetaStart start;
   while (reader.next(s)) {
     const TimeNs t = sample_time_ns(s);
     if (first) t0 = t;
     first = false;
     t1 = std::max(t1, t);
+    start.note(s);
+    start.apply(engine);
     feed_sample(engine, s);
     for (auto& st : engine.take_steps()) r.steps.push_back(st);
     for (auto& tu : engine.take_turns()) r.turns.push_back(tu);
   }
+  engine.finish();  // a walk too short for the bout gate still counts (issue 19.6)
+  for (auto& st : engine.take_steps()) r.steps.push_back(st);
+  r.heading_frame = describe_frame(engine, start);
   r.detected = engine.step_count();
   r.duration_s = first ? 0.0 : ns_to_s(t1 - t0);
   r.counters = engine.counters().accel;
@@ -108,6 +175,8 @@ FileResult run_oxford(const std::string& path, const pdr::PdrOptions& options) {
     engine.feed(s);
     for (auto& st : engine.take_steps()) r.steps.push_back(st);
   }
+  engine.finish();
+  for (auto& st : engine.take_steps()) r.steps.push_back(st);
   r.detected = engine.step_count();
   r.counters = engine.counters().accel;
   if (rec.samples.size() >= 2) r.duration_s = ns_to_s(rec.samples.back().t_ns - rec.samples.front().t_ns);
@@ -131,6 +200,7 @@ void print_file(const FileResult& r, bool list) {
               static_cast<long long>(r.detected), r.duration_s, median_cadence_hz(r.steps));
   if (r.truth >= 0) std::printf(", truth %lld", static_cast<long long>(r.truth));
   std::printf("\n");
+  if (!r.heading_frame.empty()) std::printf("  %s\n", r.heading_frame.c_str());
   const auto& c = r.counters;
   if (c.skipped() > 0 || c.gaps > 0) {
     std::printf("  accel samples skipped: %lld non-finite, %lld duplicate time, %lld backwards time; %lld gaps (detector reset)\n",

@@ -1,6 +1,7 @@
 // pdnav: the host command-line tool. Thin: parse arguments, wire io to an engine, print.
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -18,6 +19,18 @@ int main(int argc, char** argv) {
 #define PDNAV_COMMAND(name) pdnav::cli::register_##name(app);
 #include "pdnav_commands.inc"
 #undef PDNAV_COMMAND
+  // Issue 19.5: the first word that is not an option must be a command. CLI11 alone answers
+  // "A subcommand is required" for `pdnav eval-fusion`, and prints the top help (exit 0) for
+  // `pdnav NOSUCH --help`.
+  if (argc >= 2 && argv[1][0] != '-') {
+    const std::string name = argv[1];
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands({})) known = known || sub->check_name(name);
+    if (!known) {
+      std::cerr << "pdnav: error: unknown command " << name << " (pdnav --help lists the commands)\n";
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -110,11 +110,23 @@ TEST(Wmm, PolesGiveFiniteField) {
   EXPECT_TRUE(std::isfinite(f.f_nt));
 }
 
-TEST(Wmm, DeclinationHelperClampsToModelValidity) {
+TEST(Wmm, DeclinationHelperExtrapolatesOutsideEverySpanWithAWarning) {
+  // Issue 19.2: outside 2015-2030 the nearest model's secular variation is extrapolated (no
+  // silent clamp) and the result says so; a missing time uses WMM2025 at its epoch, warned.
   const Geodetic g = Geodetic::from_deg(80, 0, 0);
-  const double at_2025 = wmm_field(WmmModel::wmm2025(), g, 2025.0).declination_rad;
-  const double at_2030 = wmm_field(WmmModel::wmm2025(), g, 2030.0).declination_rad;
-  EXPECT_DOUBLE_EQ(magnetic_declination_rad(g, 0), at_2025);              // 1970 -> 2025.0
-  EXPECT_DOUBLE_EQ(magnetic_declination_rad(g, 4102444800000), at_2030);  // 2100 -> 2030.0
-  EXPECT_DOUBLE_EQ(magnetic_declination_rad(g, std::numeric_limits<std::int64_t>::min()), at_2025);
+  const Declination d2100 = declination_at(g, 4102444800000);  // 2100.0
+  EXPECT_TRUE(d2100.extrapolated);
+  EXPECT_EQ(d2100.model, "WMM-2025");
+  EXPECT_DOUBLE_EQ(d2100.declination_rad, wmm_field(WmmModel::wmm2025(), g, 2100.0).declination_rad);
+  EXPECT_NE(d2100.warning.find("outside every WMM span"), std::string::npos) << d2100.warning;
+  const Declination d2010 = declination_at(g, 1262304000000);  // 2010.0
+  EXPECT_TRUE(d2010.extrapolated);
+  EXPECT_EQ(d2010.model, "WMM-2015v2");
+  EXPECT_DOUBLE_EQ(d2010.declination_rad, wmm_field(WmmModel::wmm2015(), g, 2010.0).declination_rad);
+  const Declination missing = declination_at(g, std::numeric_limits<std::int64_t>::min());
+  EXPECT_DOUBLE_EQ(missing.declination_rad, wmm_field(WmmModel::wmm2025(), g, 2025.0).declination_rad);
+  EXPECT_FALSE(missing.warning.empty());
+  const Declination inside = declination_at(g, 1814616000000);  // 2027.5
+  EXPECT_FALSE(inside.extrapolated);
+  EXPECT_TRUE(inside.warning.empty());
 }

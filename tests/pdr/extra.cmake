@@ -18,3 +18,29 @@ add_test(NAME pdr_cli_steps_log
          COMMAND pdnav steps "${PROJECT_BINARY_DIR}/test-scratch/pdr-cli/walk.txt")
 set_tests_properties(pdr_cli_steps_log PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_cli_log
                      PASS_REGULAR_EXPRESSION "turn at [0-9.]+ s .*, (8[0-9]|9[0-9]|100) deg, left.*steps: (4[89]|5[0-9]|6[0-2])\n")
+
+# Issues 19.4 / 19.5 (steps worktree): declination from the log's Meta start, magnetic
+# headings said so, unknown commands, a raster given where a .pdem tile is expected.
+add_test(NAME steps_cli_meta_fixture COMMAND test_pdr --gtest_filter=StepsCliFixture.WriteMetaStartLog)
+set_tests_properties(steps_cli_meta_fixture PROPERTIES LABELS "pdr" FIXTURES_SETUP steps_cli_meta_log)
+add_test(NAME steps_cli_meta_declination
+         COMMAND pdnav steps "${PROJECT_BINARY_DIR}/test-scratch/steps-cli/walk_meta.txt")
+set_tests_properties(steps_cli_meta_declination PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED steps_cli_meta_log
+                     PASS_REGULAR_EXPRESSION "headings are true north: declination \\+1[01]\\.[0-9]+ deg \\(WMM-2025")
+add_test(NAME steps_cli_magnetic_without_start
+         COMMAND pdnav steps "${PROJECT_BINARY_DIR}/test-scratch/pdr-cli/walk.txt")
+set_tests_properties(steps_cli_magnetic_without_start PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_cli_log
+                     PASS_REGULAR_EXPRESSION "headings are MAGNETIC")
+foreach(_args "NOSUCH" "NOSUCH --help" "eval-nosuch --dem x.pdem")
+  string(REPLACE " " ";" _argv "${_args}")
+  list(GET _argv 0 _cmd)
+  string(MAKE_C_IDENTIFIER "steps_cli_unknown_command_${_args}" _name)
+  add_test(NAME "${_name}"
+           COMMAND sh -c "out=$(\"$0\" \"$@\" 2>&1); rc=$?; echo \"rc=$rc $out\"; [ $rc -ne 0 ] && echo \"$out\" | grep -q \"unknown command ${_cmd}\""
+                   $<TARGET_FILE:pdnav> ${_argv})
+  set_tests_properties("${_name}" PROPERTIES LABELS "cli")
+endforeach()
+add_test(NAME steps_cli_eval_terrain_hgt_zip
+         COMMAND sh -c "out=$(\"$0\" eval-terrain --dem \"$1\" --walks 1 2>&1); rc=$?; echo \"rc=$rc $out\"; [ $rc -ne 0 ] && echo \"$out\" | grep -qF \"dem-tools/pdnav_dem.py tile /vsizip/$1/N42E001.hgt -o N42E001.pdem --center 42.5 1.5 --radius 36000\""
+                 $<TARGET_FILE:pdnav> "${PDNAV_SHARED_DATA_DIR}/terrain-andorra/N42E001.hgt.zip")
+set_tests_properties(steps_cli_eval_terrain_hgt_zip PROPERTIES LABELS "terrain;cli")

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -12,6 +13,10 @@ namespace pdnav::geo {
 namespace detail {
 extern const WmmCoefficient kWmm2025Coefficients[];
 extern const std::size_t kWmm2025CoefficientCount;
+extern const WmmCoefficient kWmm2020Coefficients[];
+extern const std::size_t kWmm2020CoefficientCount;
+extern const WmmCoefficient kWmm2015v2Coefficients[];
+extern const std::size_t kWmm2015v2CoefficientCount;
 }  // namespace detail
 
 namespace {
@@ -81,19 +86,38 @@ bool is_terminator(const std::string& line) {
 
 }  // namespace
 
+namespace {
+WmmModel embedded_model(double epoch, const char* name, const char* release, const WmmCoefficient* c,
+                        std::size_t n) {
+  WmmModel m;
+  m.epoch_year = epoch;
+  m.name = name;
+  m.release_date = release;
+  m.coefficients.assign(c, c + n);
+  for (const auto& k : m.coefficients) m.n_max = std::max(m.n_max, k.n);
+  return m;
+}
+}  // namespace
+
 const WmmModel& WmmModel::wmm2025() {
-  static const WmmModel model = [] {
-    WmmModel m;
-    m.epoch_year = 2025.0;
-    m.name = "WMM-2025";
-    m.release_date = "11/13/2024";
-    m.coefficients.assign(detail::kWmm2025Coefficients,
-                          detail::kWmm2025Coefficients + detail::kWmm2025CoefficientCount);
-    for (const auto& c : m.coefficients) m.n_max = std::max(m.n_max, c.n);
-    return m;
-  }();
+  static const WmmModel model = embedded_model(2025.0, "WMM-2025", "11/13/2024", detail::kWmm2025Coefficients,
+                                               detail::kWmm2025CoefficientCount);
   return model;
 }
+
+const WmmModel& WmmModel::wmm2020() {
+  static const WmmModel model = embedded_model(2020.0, "WMM-2020", "12/10/2019", detail::kWmm2020Coefficients,
+                                               detail::kWmm2020CoefficientCount);
+  return model;
+}
+
+const WmmModel& WmmModel::wmm2015() {
+  static const WmmModel model = embedded_model(2015.0, "WMM-2015v2", "09/18/2018", detail::kWmm2015v2Coefficients,
+                                               detail::kWmm2015v2CoefficientCount);
+  return model;
+}
+
+std::vector<const WmmModel*> WmmModel::embedded() { return {&wmm2015(), &wmm2020(), &wmm2025()}; }
 
 WmmModel WmmModel::parse_cof(std::istream& in, const std::string& name) {
   WmmModel model;
@@ -193,14 +217,42 @@ double decimal_year_from_unix_ms(std::int64_t unix_ms) {
   return static_cast<double>(year) + (static_cast<double>(unix_ms) - start_ms) / len_ms;
 }
 
+Declination declination_at(const Geodetic& where, std::int64_t unix_ms) {
+  const auto models = WmmModel::embedded();
+  Declination d;
+  const WmmModel* model = models.back();
+  if (unix_ms == std::numeric_limits<std::int64_t>::min()) {
+    d.decimal_year = model->epoch_year;
+    d.warning = "no UTC time in the log: declination from " + model->name + " at its epoch";
+  } else {
+    d.decimal_year = decimal_year_from_unix_ms(unix_ms);
+    const double y = d.decimal_year;
+    bool inside = false;
+    for (const WmmModel* m : models) {
+      if (y >= m->epoch_year && y < m->epoch_year + kWmmValidityYears) {
+        model = m;
+        inside = true;
+      }
+    }
+    if (!inside) {
+      // Nearest span: the oldest model before its epoch, the newest after its end.
+      model = y < models.front()->epoch_year ? models.front() : models.back();
+      d.extrapolated = true;
+      const double years_out = y < model->epoch_year ? model->epoch_year - y : y - (model->epoch_year + kWmmValidityYears);
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "date %.2f is %.1f years outside every WMM span (%.0f-%.0f): %s extrapolated",
+                    y, years_out, models.front()->epoch_year, models.back()->epoch_year + kWmmValidityYears,
+                    model->name.c_str());
+      d.warning = buf;
+    }
+  }
+  d.model = model->name;
+  d.declination_rad = wmm_field(*model, where, d.decimal_year).declination_rad;
+  return d;
+}
+
 double magnetic_declination_rad(const Geodetic& where, std::int64_t unix_ms) {
-  const WmmModel& model = WmmModel::wmm2025();
-  constexpr double kValidityYears = 5.0;
-  const double year = unix_ms == std::numeric_limits<std::int64_t>::min()
-                          ? model.epoch_year
-                          : std::clamp(decimal_year_from_unix_ms(unix_ms), model.epoch_year,
-                                       model.epoch_year + kValidityYears);
-  return wmm_field(model, where, year).declination_rad;
+  return declination_at(where, unix_ms).declination_rad;
 }
 
 }  // namespace pdnav::geo

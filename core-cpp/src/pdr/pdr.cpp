@@ -12,31 +12,54 @@ namespace pdnav::pdr {
 Pdr::Pdr(const PdrOptions& options)
     : opt_(options),
       detector_(options.detector),
-      gate_(options.detector.bout_min_steps, options.detector.max_step_interval_s),
+      gate_(options.detector.bout_min_steps, options.detector.max_step_interval_s,
+            options.detector.short_walk_min_steps),
       tracker_(options.heading.turn) {}
 
 void Pdr::set_location(const geo::Geodetic& where, std::int64_t utc_ms) {
-  const double d = geo::magnetic_declination_rad(where, utc_ms);
-  if (std::isfinite(d)) declination_rad_ = d;
+  const geo::Declination d = geo::declination_at(where, utc_ms);
+  if (!std::isfinite(d.declination_rad)) return;
+  declination_ = d;
+  declination_rad_ = d.declination_rad;
+  has_location_ = true;
 }
 
 void Pdr::feed(const AccelSample& s) {
   tracker_.feed(s);
-  const auto candidate = detector_.feed(s);
+  const auto candidates = detector_.feed(s);
   if (detector_.counters().gaps != gaps_seen_) {  // a gap resets the detector and the bout
     gaps_seen_ = detector_.counters().gaps;
-    gate_.end_bout();
+    release(gate_.end_bout(), s.t_ns);
   }
   latest_ns_ = std::max(latest_ns_, s.t_ns);
-  if (!candidate) return;
-  for (const auto& c : gate_.push(candidate->t_ns, *candidate)) {
-    accel_step_times_.push_back(c.t_ns);
-    const bool use = opt_.source == StepSource::kAccelerometer ||
-                     (opt_.source == StepSource::kAuto && !android_active(s.t_ns));
-    if (use) emit_step(c.t_ns, c.swing_mps2);
-  }
+  release(gate_.expire(s.t_ns), s.t_ns);
+  for (const auto& c : candidates) release(gate_.push(c.t_ns, hold(c.t_ns, c.swing_mps2)), s.t_ns);
   trim_consistency(s.t_ns);
 }
+
+Pdr::HeldStep Pdr::hold(TimeNs t_ns, double swing_mps2) const {
+  HeldStep h;
+  h.candidate.t_ns = t_ns;
+  h.candidate.swing_mps2 = swing_mps2;
+  // The heading at the step's own time (issue 20.2): magnetic when referenced to the rotation
+  // vector or compass (declination added when the step is taken), true when gyro-only from
+  // the configured initial heading.
+  h.magnetic = have_heading_;
+  h.heading_rad = wrap_two_pi(heading_rad() - (have_heading_ ? declination_rad_ : 0.0));
+  h.heading_sigma_rad = heading_sigma_rad();
+  return h;
+}
+
+void Pdr::release(const std::vector<HeldStep>& steps, TimeNs now_ns) {
+  for (const auto& h : steps) {
+    accel_step_times_.push_back(h.candidate.t_ns);
+    const bool use = opt_.source == StepSource::kAccelerometer ||
+                     (opt_.source == StepSource::kAuto && !android_active(now_ns));
+    if (use) emit_step(h);
+  }
+}
+
+void Pdr::finish() { release(gate_.finish(), latest_ns_); }
 
 void Pdr::feed(const GyroSample& s) {
   tracker_.feed(s);
@@ -104,7 +127,7 @@ void Pdr::feed(const StepDetectorSample& s) {
   have_android_ = true;
   last_android_ns_ = s.t_ns;
   if (opt_.source == StepSource::kAndroid || opt_.source == StepSource::kAuto) {
-    emit_step(s.t_ns, kNaN);
+    emit_step(hold(s.t_ns, kNaN));
   }
   trim_consistency(s.t_ns);
 }
@@ -125,14 +148,15 @@ double Pdr::heading_sigma_rad() const {
   return std::min(kPi, base + opt_.heading.gyro_drift_radps * std::max(0.0, ns_to_s(since)));
 }
 
-void Pdr::emit_step(TimeNs t_ns, double swing_mps2) {
+void Pdr::emit_step(const HeldStep& h) {
   PdrStep st;
-  st.t_ns = t_ns;
-  st.length_m = opt_.length.length_m(swing_mps2);
+  st.t_ns = h.candidate.t_ns;
+  st.length_m = opt_.length.length_m(h.candidate.swing_mps2);
   st.length_sigma_m = opt_.length.sigma_m(st.length_m);
-  st.heading_rad = heading_rad();
-  st.heading_sigma_rad = heading_sigma_rad();
+  st.heading_rad = h.heading_rad;
+  st.heading_sigma_rad = h.heading_sigma_rad;
   steps_.push_back(st);
+  steps_magnetic_.push_back(h.magnetic ? 1 : 0);
   ++step_count_;
 }
 
@@ -157,6 +181,10 @@ StepConsistency Pdr::consistency() const {
 std::vector<PdrStep> Pdr::take_steps() {
   std::vector<PdrStep> out;
   out.swap(steps_);
+  for (std::size_t i = 0; i < out.size() && i < steps_magnetic_.size(); ++i) {
+    if (steps_magnetic_[i]) out[i].heading_rad = wrap_two_pi(out[i].heading_rad + declination_rad_);
+  }
+  steps_magnetic_.clear();
   return out;
 }
 

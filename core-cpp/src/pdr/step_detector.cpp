@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 
 namespace pdnav::pdr {
 
@@ -36,6 +37,8 @@ StepDetectorOptions StepDetectorOptions::paper() {
   o.min_sigma_mps2 = 0.0;
   o.min_swing_mps2 = 0.0;
   o.bout_min_steps = 1;
+  o.short_walk_min_steps = 0;
+  o.stride_harmonic_ratio = 0.0;
   return o;
 }
 
@@ -52,6 +55,8 @@ void StepDetector::reset() {
   period_max_ = period_min_ = 0.0;
   have_step_ = false;
   typical_interval_s_ = 0.0;
+  history_.clear();
+  prev_stride_like_ = false;
 }
 
 double StepDetector::filter(double magnitude, double dt_s) {
@@ -135,11 +140,69 @@ std::optional<StepCandidate> StepDetector::on_symbol(Symbol sym, TimeNs t_ns, do
   return c;
 }
 
-std::optional<StepCandidate> StepDetector::feed(const AccelSample& s) {
+bool StepDetector::stride_like(TimeNs t_ns, double interval_s) const {
+  if (opt_.stride_harmonic_ratio <= 0.0 || interval_s < opt_.stride_min_interval_s ||
+      interval_s > opt_.stride_max_interval_s) {
+    return false;
+  }
+  // Single-bin DFTs over the last two intervals (whole cycles, so the bins are orthogonal):
+  // |a| at f1 = 1/I (stride) and f2 = 2/I (step); the tilt direction at f1 and at f1/2.
+  const TimeNs from = t_ns - s_to_ns(2.0 * interval_s);
+  double mean = 0.0;
+  Eigen::Vector3d mean_dir = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (const auto& h : history_) {
+    if (h.t_ns < from) continue;
+    mean += h.value;
+    mean_dir += h.dir;
+    ++n;
+  }
+  if (n < 8) return false;
+  mean /= n;
+  mean_dir /= n;
+  std::complex<double> x1 = 0.0, x2 = 0.0;
+  Eigen::Vector3cd d1 = Eigen::Vector3cd::Zero(), dh = Eigen::Vector3cd::Zero();
+  for (const auto& h : history_) {
+    if (h.t_ns < from) continue;
+    const double ph = 2.0 * kPi * ns_to_s(h.t_ns - t_ns) / interval_s;
+    const std::complex<double> e1 = std::polar(1.0, -ph), e2 = std::polar(1.0, -2.0 * ph), eh = std::polar(1.0, -0.5 * ph);
+    x1 += (h.value - mean) * e1;
+    x2 += (h.value - mean) * e2;
+    const Eigen::Vector3d dd = h.dir - mean_dir;
+    d1 += dd.cast<std::complex<double>>() * e1;
+    dh += dd.cast<std::complex<double>>() * eh;
+  }
+  const double a1 = std::abs(x1);
+  const double step_power = a1 > 0.0 ? std::abs(x2) / a1 : 0.0;
+  const double tilt_1 = 2.0 * d1.norm() / n;  // amplitude (rad, small-angle) at 1/I
+  const double tilt_half = 2.0 * dh.norm() / n;
+  return step_power > opt_.stride_harmonic_ratio && tilt_1 > opt_.stride_min_tilt_rad && tilt_1 > tilt_half;
+}
+
+void StepDetector::split_strides(const StepCandidate& c, std::vector<StepCandidate>& out) {
+  const bool like = stride_like(c.t_ns, c.interval_s);
+  const bool split = like && prev_stride_like_;
+  prev_stride_like_ = like;
+  if (!split) {
+    out.push_back(c);
+    return;
+  }
+  StepCandidate mid = c;
+  mid.t_ns = c.t_ns - s_to_ns(0.5 * c.interval_s);
+  mid.interval_s = 0.5 * c.interval_s;
+  StepCandidate second = c;
+  second.interval_s = 0.5 * c.interval_s;
+  out.push_back(mid);
+  out.push_back(second);
+  ++stride_steps_added_;
+}
+
+std::vector<StepCandidate> StepDetector::feed(const AccelSample& s) {
+  std::vector<StepCandidate> out;
   const bool finite = s.acc_mps2.allFinite();
   const SampleCheck check = check_sample(s.t_ns, finite, last_t_ns_, have_last_, opt_.gap_reset_s, counters_);
   if (check == SampleCheck::kNonFinite || check == SampleCheck::kDuplicate || check == SampleCheck::kBackwards) {
-    return std::nullopt;
+    return out;
   }
   if (check == SampleCheck::kGap) reset();
   const double dt_s = have_last_ ? ns_to_s(s.t_ns - last_t_ns_) : 0.0;
@@ -147,24 +210,43 @@ std::optional<StepCandidate> StepDetector::feed(const AccelSample& s) {
   last_t_ns_ = s.t_ns;
   const double value = filter(s.acc_mps2.norm(), dt_s);
   push_window(s.t_ns, value);
-  return on_symbol(quantise(value), s.t_ns, value);
+  if (opt_.stride_harmonic_ratio > 0.0) {
+    // Tilt: the specific force low-passed (same two sections as |a|) and normalised.
+    if (history_.empty()) {
+      lpv1_ = lpv2_ = s.acc_mps2;
+    } else {
+      const double tau = 1.0 / (2.0 * kPi * std::max(opt_.lowpass_hz, 1.0));
+      const double alpha = dt_s / (tau + dt_s);
+      lpv1_ += alpha * (s.acc_mps2 - lpv1_);
+      lpv2_ += alpha * (lpv1_ - lpv2_);
+    }
+    const double norm = lpv2_.norm();
+    history_.push_back({s.t_ns, value, norm > 1e-6 ? Eigen::Vector3d(lpv2_ / norm) : Eigen::Vector3d::UnitZ()});
+    const TimeNs keep = s_to_ns(2.0 * opt_.stride_max_interval_s);
+    while (!history_.empty() && history_.front().t_ns < s.t_ns - keep) history_.pop_front();
+  }
+  const auto c = on_symbol(quantise(value), s.t_ns, value);
+  if (c) split_strides(*c, out);
+  return out;
 }
 
 std::vector<StepCandidate> detect_steps(const std::vector<AccelSample>& samples,
                                         const StepDetectorOptions& options, SampleCounters* counters) {
   StepDetector detector(options);
-  BoutGate<StepCandidate> gate(options.bout_min_steps, options.max_step_interval_s);
+  BoutGate<StepCandidate> gate(options.bout_min_steps, options.max_step_interval_s, options.short_walk_min_steps);
   std::vector<StepCandidate> steps;
   std::int64_t gaps_seen = 0;
   for (const auto& s : samples) {
-    const auto c = detector.feed(s);
+    const auto candidates = detector.feed(s);
     if (detector.counters().gaps != gaps_seen) {  // a gap resets the bout as well
       gaps_seen = detector.counters().gaps;
-      gate.end_bout();
+      for (auto& released : gate.end_bout()) steps.push_back(released);
     }
-    if (!c) continue;
-    for (auto& released : gate.push(c->t_ns, *c)) steps.push_back(released);
+    for (const auto& c : candidates) {
+      for (auto& released : gate.push(c.t_ns, c)) steps.push_back(released);
+    }
   }
+  for (auto& released : gate.finish()) steps.push_back(released);
   if (counters) *counters = detector.counters();
   return steps;
 }

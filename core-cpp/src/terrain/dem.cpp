@@ -1,8 +1,12 @@
 // .pdem reader (docs/dem-format.md) and bilinear lookups.
 #include "pdnav/terrain/dem.h"
 
+#include "pdnav/geo/units.h"
+
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -16,6 +20,44 @@ namespace {
 constexpr std::size_t kMaxHeaderBytes = 64 * 1024;
 constexpr std::int64_t kMaxNodes = 256LL * 1024 * 1024;  // 1 GiB of float32
 constexpr int kMaxSide = 1 << 20;
+
+/// The "not a .pdem" error, with the exact dem-tools command that makes a tile from the file
+/// (issue 19.5): an SRTM name (N43E007.hgt[.zip]) gives its one-degree box; another raster
+/// (GeoTIFF, DTED, ...) the command with the area left to the user.
+std::string not_pdem_message(const std::string& name) {
+  std::string msg = "bad magic (not a .pdem tile): expected 'PDEM 1'";
+  const auto slash = name.find_last_of('/');
+  const std::string base = slash == std::string::npos ? name : name.substr(slash + 1);
+  std::string stem = base, gdal_path = name;
+  const auto ends_with = [](const std::string& s, const std::string& suffix) {
+    return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  if (ends_with(base, ".pdem") || base.empty()) return msg;
+  if (ends_with(base, ".zip")) {
+    stem = base.substr(0, base.size() - 4);
+    gdal_path = "/vsizip/" + name + "/" + stem;  // the raster inside the zip
+  }
+  const std::string tile = stem.substr(0, stem.find('.'));
+  int lat = 0, lon = 0;
+  char ns = 0, ew = 0;
+  const bool srtm = tile.size() == 7 && std::sscanf(tile.c_str(), "%c%2d%c%3d", &ns, &lat, &ew, &lon) == 4 &&
+                    (ns == 'N' || ns == 'S') && (ew == 'E' || ew == 'W');
+  msg += "; make one with: dem-tools/pdnav_dem.py tile " + gdal_path + " -o " + tile + ".pdem";
+  if (srtm) {
+    // The tile's centre and the largest square (in metres) that stays inside the one-degree
+    // tile at its poleward edge, with a 10 % margin (the tool refuses an area partly outside).
+    const int s = ns == 'N' ? lat : -lat, w = ew == 'E' ? lon : -lon;
+    const double poleward_rad = std::max(std::abs(s), std::abs(s + 1)) * pdnav::kDegToRad;
+    constexpr double kMetresPerDegree = 111320.0;
+    const double radius_m = 0.45 * kMetresPerDegree * std::min(1.0, std::cos(poleward_rad));
+    char area[96];
+    std::snprintf(area, sizeof area, " --center %.1f %.1f --radius %.0f", s + 0.5, w + 0.5, 1000.0 * std::floor(radius_m / 1000.0));
+    msg += std::string(area) + " --cell 30 --fill-voids";
+  } else {
+    msg += " --center LAT LON --radius METRES";
+  }
+  return msg + " (docs/dem-format.md)";
+}
 
 /// Header lines "key value" after the magic line, up to "end_header".
 struct RawHeader {
@@ -36,7 +78,7 @@ RawHeader split_header(const std::uint8_t* data, std::size_t size, const std::st
     pos = end + 1;
     ++line_no;
     if (line_no == 1) {
-      if (line.rfind("PDEM ", 0) != 0) throw DemError(name, "bad magic (not a .pdem tile): expected 'PDEM 1'");
+      if (line.rfind("PDEM ", 0) != 0) throw DemError(name, not_pdem_message(name));
       h.fields["version"] = line.substr(5);
       continue;
     }
@@ -51,7 +93,7 @@ RawHeader split_header(const std::uint8_t* data, std::size_t size, const std::st
     if (!h.fields.emplace(key, line.substr(sp + 1)).second)
       throw DemError(name, "header line " + std::to_string(line_no) + ": duplicate key '" + key + "'");
   }
-  if (line_no == 0) throw DemError(name, size == 0 ? "empty file" : "bad magic (not a .pdem tile): expected 'PDEM 1'");
+  if (line_no == 0) throw DemError(name, size == 0 ? "empty file" : not_pdem_message(name));
   if (!ended) throw DemError(name, "truncated or oversized header: no 'end_header' line in the first 64 KiB");
   h.data_offset = pos;
   return h;

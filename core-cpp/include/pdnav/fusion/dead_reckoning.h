@@ -2,6 +2,9 @@
 // A 3-state EKF [east, north, heading bias] whose bias is first-order Gauss-Markov as in
 // Broyles et al., Sensors 2018, Eq. 3-4 (sigma_theta 15 deg, tau_theta 60 s); no measurements,
 // so the mean is plain dead reckoning and the covariance grows the way the bias makes it.
+// Issue 19.1: each step's own heading sigma (from the PDR) sets the bias' spread at that step,
+// so a phone that gives no absolute heading (sigma = pi) grows the ellipse as it should, and
+// the estimate says "relative heading only" until an absolute heading has been seen.
 #pragma once
 #include <Eigen/Core>
 
@@ -15,6 +18,15 @@ struct DeadReckoningOptions {
   double heading_bias_sigma_rad = 15.0 * kDegToRad;  // Broyles 2018, Table 1
   double heading_bias_tau_s = 60.0;                   // Broyles 2018, Table 1
   double length_sigma_m = 0.15;                       // Broyles 2018, sigma_l
+  // Per-step heading sigma (issue 19.1; docs/pdr.md "Dead-reckoning ellipse"). A step whose
+  // PdrStep::heading_sigma_rad is below absolute_heading_max_sigma_rad has an absolute
+  // heading: its sigma replaces heading_bias_sigma_rad as the bias' stationary sigma (the EKF's
+  // linearisation holds). Above it (no absolute heading, e.g. sigma = pi) the path is known
+  // only up to a rotation about the start by an angle of that sigma; that error is added in
+  // closed form (rotation_covariance), since a linear model fails for large angles (it has no
+  // along-track error at all). 0/NaN sigma = unknown: the fixed model above.
+  bool use_step_heading_sigma = true;
+  double absolute_heading_max_sigma_rad = 60.0 * kDegToRad;
 };
 
 class DeadReckoning {
@@ -24,6 +36,10 @@ class DeadReckoning {
   bool initialized() const { return initialized_; }
   void feed(const PdrStep& step);
   Estimate estimate() const;
+  /// True once a step came with an absolute heading (sigma below absolute_heading_max_sigma_rad).
+  bool has_absolute_heading() const { return absolute_heading_seen_; }
+  /// Covariance (east/north, m^2) of R(e) p - p for a path displacement p and a rotation e ~ N(0, sigma^2).
+  static Eigen::Matrix2d rotation_covariance(const Eigen::Vector2d& p_en_m, double sigma_rad);
   const geo::LocalFrame& frame() const { return frame_; }
 
  private:
@@ -33,6 +49,9 @@ class DeadReckoning {
   Eigen::Vector3d x_ = Eigen::Vector3d::Zero();  // e, n, heading bias
   Eigen::Matrix3d p_ = Eigen::Matrix3d::Zero();
   TimeNs t_ns_ = 0;
+  bool have_steps_ = false;
+  bool absolute_heading_seen_ = false;
+  double rotation_sigma_rad_ = 0.0;  // heading sigma while only a relative heading is known
 };
 
 }  // namespace pdnav::fusion

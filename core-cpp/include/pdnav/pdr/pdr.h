@@ -9,6 +9,7 @@
 #include "pdnav/geo/events.h"
 #include "pdnav/geo/frames.h"
 #include "pdnav/geo/samples.h"
+#include "pdnav/geo/wmm.h"
 #include "pdnav/pdr/heading.h"
 #include "pdnav/pdr/step_detector.h"
 #include "pdnav/pdr/step_length.h"
@@ -70,7 +71,12 @@ class Pdr {
   /// applies to the steps detected from now on.
   void set_length_model(const StepLengthModel& model) { opt_.length = model; }
 
-  /// Steps since the last call (time, length, TRUE-north heading, sigmas).
+  /// End of the input: a walk too short for the bout gate is released if it qualifies
+  /// (StepDetectorOptions::short_walk_min_steps). Take the steps afterwards.
+  void finish();
+  /// Steps since the last call (time, length, TRUE-north heading, sigmas). Each step carries
+  /// its own time and the heading at that time; the declination known at this call is applied
+  /// to every step whose heading came from a magnetic reference (one frame for all steps).
   std::vector<PdrStep> take_steps();
   /// Turns since the last call (APT Sec. V-B, positive = left).
   std::vector<PdrTurn> take_turns();
@@ -81,18 +87,31 @@ class Pdr {
   double heading_rad() const;
   double heading_sigma_rad() const;
   double declination_rad() const { return declination_rad_; }
+  /// The declination in use, its WMM model and any warning (date outside every model's span,
+  /// no UTC time); `has_location()` is false while headings are still magnetic.
+  const geo::Declination& declination() const { return declination_; }
+  bool has_location() const { return has_location_; }
   PdrCounters counters() const;
   StepConsistency consistency() const;
   const PdrOptions& options() const { return opt_; }
 
  private:
-  void emit_step(TimeNs t_ns, double swing_mps2);
+  /// A step candidate with the heading at its own time (before the bout gate releases it).
+  struct HeldStep {
+    StepCandidate candidate;
+    double heading_rad = 0.0;  // magnetic if `magnetic`, else true
+    double heading_sigma_rad = 0.0;
+    bool magnetic = false;
+  };
+  HeldStep hold(TimeNs t_ns, double swing_mps2) const;
+  void release(const std::vector<HeldStep>& steps, TimeNs now_ns);
+  void emit_step(const HeldStep& h);
   bool android_active(TimeNs t_ns) const;
   void trim_consistency(TimeNs t_ns);
 
   PdrOptions opt_;
   StepDetector detector_;
-  BoutGate<StepCandidate> gate_;
+  BoutGate<HeldStep> gate_;
   GyroTurnTracker tracker_;
   std::int64_t gaps_seen_ = 0;
   PdrCounters counters_;
@@ -112,9 +131,12 @@ class Pdr {
   bool have_sd_last_ = false;
   TimeNs sd_last_ns_ = 0;
   double declination_rad_ = 0.0;
+  geo::Declination declination_;
+  bool has_location_ = false;
   TimeNs latest_ns_ = 0;
   // outputs
   std::vector<PdrStep> steps_;
+  std::vector<char> steps_magnetic_;  // per steps_ entry: heading still magnetic
   std::int64_t step_count_ = 0;
   std::deque<TimeNs> accel_step_times_, android_step_times_;
   TimeNs last_android_ns_ = 0;

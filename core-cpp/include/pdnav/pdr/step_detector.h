@@ -2,10 +2,13 @@
 // "APT: Accurate Outdoor Pedestrian Tracking with Smartphones", INFOCOM 2013, Sec. V-A)
 // plus the gates real data needs (low-pass, minimum step interval, walking gate, bout gate).
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <deque>
 #include <optional>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "pdnav/geo/samples.h"
 
@@ -48,7 +51,25 @@ struct StepDetectorOptions {
   // --- Bout gate (like the phones' hardware counter): steps count only inside a bout of at
   // least bout_min_steps steps whose intervals are all below max_step_interval_s.
   int bout_min_steps = 4;              // 1 = every step counts at once (paper form)
+  // A walk shorter than the bout (issue 19.6) still counts once it ends, if it has at least
+  // this many regular steps (3 = a 2 m walk; 2 steps alone are as likely a jolt). 0 = off.
+  int short_walk_min_steps = 3;
   double max_step_interval_s = 1.3;    // longer pause ends the bout (cadence >= ~0.8 Hz)
+  // --- Swinging hand (issue 20.1, docs/pdr.md "Swinging hand"): an arm swings at the STRIDE
+  // frequency, so |a| peaks once per stride and the level crossings count every other step.
+  // A candidate whose interval is stride-like and whose filtered |a| over the last two
+  // intervals carries real power at twice 1/interval (the body's bounce and the heel strikes,
+  // i.e. the step frequency) is a stride: the step between is emitted at the midpoint. Needs
+  // two such candidates in a row (one odd long interval is a pause or a missed step, not a
+  // swinging arm). Measured: real pocket/bag/hand/texting walks have < 1 % stride-like
+  // candidates in a row; the simulated swinging hand > 90 %. 0 = off.
+  double stride_min_interval_s = 0.75;  // shortest stride (cadence <= 2.67 steps/s)
+  double stride_max_interval_s = 2.6;   // longest stride (cadence >= 0.77 steps/s)
+  double stride_harmonic_ratio = 0.1;   // |X(2/I)| / |X(1/I)| of |a| above this = step power present
+  // The phone must also swing at 1/I: its tilt (direction of the low-passed specific force)
+  // oscillates once per interval by more than this amplitude, and more than at 1/(2I) (a
+  // pocket phone on a slow walk swings with the thigh once per STRIDE = every 2 intervals).
+  double stride_min_tilt_rad = 3.0 * kDegToRad;
   // --- Input hygiene.
   double gap_reset_s = 0.5;            // a sample gap longer than this resets the detector
 
@@ -64,16 +85,22 @@ struct StepCandidate {
 };
 
 /// Holds steps until a bout of `min_steps` regular steps is confirmed, then releases them; while
-/// a bout lasts every step is released at once. Payload T carries the caller's data.
+/// a bout lasts every step is released at once. Payload T carries the caller's data (its own
+/// time, so a released step keeps the time it was taken). A walk that ends before the gate
+/// confirmed it (issue 19.6: a 2 m walk) is released when it ends - no step for
+/// max_interval_s (expire), a gap (end_bout) or the end of the input (finish) - if it has at
+/// least `short_walk_min_steps` steps with regular intervals (longest / shortest <= 2).
 template <typename T>
 class BoutGate {
  public:
-  BoutGate(int min_steps, double max_interval_s) : min_steps_(min_steps), max_interval_ns_(s_to_ns(max_interval_s)) {}
+  BoutGate(int min_steps, double max_interval_s, int short_walk_min_steps = 3)
+      : min_steps_(min_steps), short_min_(short_walk_min_steps), max_interval_ns_(s_to_ns(max_interval_s)) {}
 
-  /// Adds a step at t_ns; returns the steps released by it (possibly several, possibly none).
+  /// Adds a step at t_ns; returns the steps released by it (possibly several, possibly none):
+  /// a short walk ended by the pause before this step, then this bout's steps.
   std::vector<T> push(TimeNs t_ns, T payload) {
     std::vector<T> out;
-    if (have_last_ && t_ns - last_t_ns_ > max_interval_ns_) end_bout();
+    if (have_last_ && t_ns - last_t_ns_ > max_interval_ns_) out = end_bout();
     have_last_ = true;
     last_t_ns_ = t_ns;
     if (in_bout_) {
@@ -81,31 +108,66 @@ class BoutGate {
       return out;
     }
     pending_.push_back(std::move(payload));
+    pending_t_.push_back(t_ns);
     if (static_cast<int>(pending_.size()) >= min_steps_) {
       in_bout_ = true;
-      out.assign(std::make_move_iterator(pending_.begin()), std::make_move_iterator(pending_.end()));
-      pending_.clear();
+      release_pending(out);
     }
     return out;
   }
-  /// Ends the current bout (e.g. after a gap); unconfirmed steps are discarded.
-  void end_bout() {
+  /// Time passes without a step (call with the latest sample time): a walk that has ended
+  /// (no step for max_interval_s) is closed; returns a short walk's steps if it qualifies.
+  std::vector<T> expire(TimeNs now_ns) {
+    if (have_last_ && now_ns - last_t_ns_ > max_interval_ns_) return end_bout();
+    return {};
+  }
+  /// End of the input: closes the current walk (see expire).
+  std::vector<T> finish() { return end_bout(); }
+  /// Ends the current bout (e.g. after a gap). Unconfirmed steps are released as a short walk
+  /// when they qualify, otherwise discarded (and counted).
+  std::vector<T> end_bout() {
+    std::vector<T> out;
+    if (!in_bout_ && short_walk_qualifies()) {
+      short_walk_steps_ += static_cast<std::int64_t>(pending_.size());
+      release_pending(out);
+    }
     discarded_ += static_cast<std::int64_t>(pending_.size());
     pending_.clear();
+    pending_t_.clear();
     in_bout_ = false;
     have_last_ = false;
+    return out;
   }
   std::int64_t discarded() const { return discarded_; }
+  std::int64_t short_walk_steps() const { return short_walk_steps_; }
   bool in_bout() const { return in_bout_; }
 
  private:
+  void release_pending(std::vector<T>& out) {
+    for (auto& p : pending_) out.push_back(std::move(p));
+    pending_.clear();
+    pending_t_.clear();
+  }
+  bool short_walk_qualifies() const {
+    if (short_min_ <= 0 || static_cast<int>(pending_.size()) < short_min_ || pending_t_.size() < 2) return false;
+    TimeNs lo = pending_t_[1] - pending_t_[0], hi = lo;
+    for (std::size_t i = 2; i < pending_t_.size(); ++i) {
+      lo = std::min(lo, pending_t_[i] - pending_t_[i - 1]);
+      hi = std::max(hi, pending_t_[i] - pending_t_[i - 1]);
+    }
+    return lo > 0 && hi <= 2 * lo;
+  }
+
   int min_steps_;
+  int short_min_;
   TimeNs max_interval_ns_;
   std::vector<T> pending_;
+  std::vector<TimeNs> pending_t_;
   bool in_bout_ = false;
   bool have_last_ = false;
   TimeNs last_t_ns_ = 0;
   std::int64_t discarded_ = 0;
+  std::int64_t short_walk_steps_ = 0;
 };
 
 /// Level-crossing step detector on the acceleration magnitude (APT Sec. V-A). Incremental:
@@ -114,9 +176,12 @@ class StepDetector {
  public:
   explicit StepDetector(const StepDetectorOptions& options = {});
 
-  /// Feeds one accelerometer sample; returns a raw step candidate when a period completes.
-  /// Candidates are not yet bout-gated: use BoutGate (as Pdr and count_steps do).
-  std::optional<StepCandidate> feed(const AccelSample& s);
+  /// Feeds one accelerometer sample; returns the raw step candidates completed by it, in time
+  /// order: none, one, or two when a stride was recognised (the midpoint step, then this one).
+  /// Candidates are not yet bout-gated: use BoutGate (as Pdr and detect_steps do).
+  std::vector<StepCandidate> feed(const AccelSample& s);
+  /// Steps added at stride midpoints so far (swinging-hand mode).
+  std::int64_t stride_steps_added() const { return stride_steps_added_; }
   /// Clears all state but the counters (called on gaps).
   void reset();
 
@@ -128,11 +193,18 @@ class StepDetector {
     TimeNs t_ns;
     double value;
   };
+  struct Tilted {
+    TimeNs t_ns;
+    double value;           // filtered |a|
+    Eigen::Vector3d dir;    // unit vector of the low-passed specific force (phone tilt)
+  };
   enum class Symbol { kUndefined, kLow, kHigh };
   double filter(double magnitude, double dt_s);
   void push_window(TimeNs t_ns, double value);
   Symbol quantise(double value) const;
   std::optional<StepCandidate> on_symbol(Symbol sym, TimeNs t_ns, double value);
+  void split_strides(const StepCandidate& c, std::vector<StepCandidate>& out);
+  bool stride_like(TimeNs t_ns, double interval_s) const;
 
   StepDetectorOptions opt_;
   SampleCounters counters_;
@@ -151,6 +223,11 @@ class StepDetector {
   bool have_step_ = false;
   TimeNs last_step_ns_ = 0;
   double typical_interval_s_ = 0.0;  // running average of in-bout step intervals (0 = none yet)
+  // stride recognition (swinging hand)
+  std::deque<Tilted> history_;       // the last 2 * stride_max_interval_s
+  Eigen::Vector3d lpv1_ = Eigen::Vector3d::Zero(), lpv2_ = Eigen::Vector3d::Zero();
+  bool prev_stride_like_ = false;
+  std::int64_t stride_steps_added_ = 0;
 };
 
 /// Offline helper: runs detector + bout gate over a whole recording, returns the step times.
