@@ -32,17 +32,39 @@ JavaBatchArrays arrays(jintArray k, jlongArray t, jlongArray i, jdoubleArray d, 
   return JavaBatchArrays{k, t, i, d, s, b};
 }
 
-jclass find_class(JNIEnv* env, const char* name) {
-  jclass c = env->FindClass(name);
-  if (c == nullptr) throw JavaError(kRuntime, std::string("class not found: ") + name);
-  return c;
+/// Classes and constructors the bridge builds, looked up once in JNI_OnLoad (global
+/// references; read-only afterwards). FindClass per call is slow, and on a thread the
+/// native side attached itself it would search the system class loader, not the app's.
+struct ClassCache {
+  jclass estimate = nullptr;
+  jclass output = nullptr;
+  jclass string = nullptr;
+  jmethodID estimate_ctor = nullptr;
+  jmethodID output_ctor = nullptr;
+};
+ClassCache g_classes;  // set once at load, before any native can run
+
+bool load_classes(JNIEnv* env, ClassCache& c) {
+  auto global = [env](const char* name) -> jclass {
+    jclass local = env->FindClass(name);
+    if (local == nullptr) return nullptr;
+    auto g = static_cast<jclass>(env->NewGlobalRef(local));
+    env->DeleteLocalRef(local);
+    return g;
+  };
+  c.estimate = global(kEstimateClass);
+  c.output = global(kOutputClass);
+  c.string = global("java/lang/String");
+  if (c.estimate == nullptr || c.output == nullptr || c.string == nullptr) return false;
+  c.estimate_ctor = env->GetMethodID(c.estimate, "<init>", kEstimateCtor);
+  c.output_ctor = env->GetMethodID(c.output, "<init>", kOutputCtor);
+  return c.estimate_ctor != nullptr && c.output_ctor != nullptr;
 }
 
 jobject new_estimate(JNIEnv* env, const Estimate& e) {
-  jclass c = find_class(env, kEstimateClass);
-  jmethodID ctor = env->GetMethodID(c, "<init>", kEstimateCtor);
-  if (ctor == nullptr) throw JavaError(kRuntime, "NavEstimate constructor not found");
-  jstring reason = env->NewStringUTF(e.reason.c_str());
+  jclass c = g_classes.estimate;
+  jmethodID ctor = g_classes.estimate_ctor;
+  jstring reason = new_string(env, e.reason);
   const bool has_position = e.status != EstimateStatus::kNotInitialized;
   const double nan = std::nan("");
   jobject o = env->NewObject(c, ctor, static_cast<jlong>(e.t_ns), static_cast<jint>(e.engine),
@@ -53,7 +75,6 @@ jobject new_estimate(JNIEnv* env, const Estimate& e) {
                              e.cov_en_m2(0, 0), e.cov_en_m2(0, 1), e.cov_en_m2(1, 1),
                              e.vertical_sigma_m);
   env->DeleteLocalRef(reason);
-  env->DeleteLocalRef(c);
   if (o == nullptr) throw JavaError(kRuntime, "NavEstimate allocation failed");
   return o;
 }
@@ -71,14 +92,13 @@ jintArray layout(JNIEnv* env, jclass) {
 }
 
 jobjectArray names(JNIEnv* env, const std::vector<std::string>& v) {
-  jclass sc = find_class(env, "java/lang/String");
-  jobjectArray a = env->NewObjectArray(static_cast<jsize>(v.size()), sc, nullptr);
+  jobjectArray a = env->NewObjectArray(static_cast<jsize>(v.size()), g_classes.string, nullptr);
+  if (a == nullptr) throw JavaError(kRuntime, "String[] allocation failed");
   for (std::size_t i = 0; i < v.size(); ++i) {
-    jstring s = env->NewStringUTF(v[i].c_str());
+    jstring s = new_string(env, v[i]);
     env->SetObjectArrayElement(a, static_cast<jsize>(i), s);
     env->DeleteLocalRef(s);
   }
-  env->DeleteLocalRef(sc);
   return a;
 }
 
@@ -178,8 +198,8 @@ jobject nav_output(JNIEnv* env, jclass, jlong handle, jint max_particles) {
       out = h.object.output(static_cast<std::size_t>(max_particles));
     }
     jobject best = new_estimate(env, out.estimate);
-    jclass ec = find_class(env, kEstimateClass);
-    jobjectArray engines = env->NewObjectArray(static_cast<jsize>(out.engines.size()), ec, nullptr);
+    jobjectArray engines =
+        env->NewObjectArray(static_cast<jsize>(out.engines.size()), g_classes.estimate, nullptr);
     for (std::size_t i = 0; i < out.engines.size(); ++i) {
       jobject e = new_estimate(env, out.engines[i]);
       env->SetObjectArrayElement(engines, static_cast<jsize>(i), e);
@@ -193,12 +213,8 @@ jobject nav_output(JNIEnv* env, jclass, jlong handle, jint max_particles) {
     }
     jdoubleArray particles = env->NewDoubleArray(static_cast<jsize>(en.size()));
     env->SetDoubleArrayRegion(particles, 0, static_cast<jsize>(en.size()), en.data());
-    jclass oc = find_class(env, kOutputClass);
-    jmethodID ctor = env->GetMethodID(oc, "<init>", kOutputCtor);
-    if (ctor == nullptr) throw JavaError(kRuntime, "NavOutput constructor not found");
-    jobject o = env->NewObject(oc, ctor, best, engines, static_cast<jlong>(out.steps), particles);
-    env->DeleteLocalRef(ec);
-    env->DeleteLocalRef(oc);
+    jobject o = env->NewObject(g_classes.output, g_classes.output_ctor, best, engines,
+                               static_cast<jlong>(out.steps), particles);
     return o;
   });
 }
@@ -375,5 +391,6 @@ extern "C" JNIEXPORT jint JNI_OnLoad(JavaVM* vm, void*) {
   const auto n = static_cast<jint>(sizeof(pdnav::jni::kMethods) / sizeof(pdnav::jni::kMethods[0]));
   if (env->RegisterNatives(c, pdnav::jni::kMethods, n) != JNI_OK) return JNI_ERR;
   env->DeleteLocalRef(c);
+  if (!pdnav::jni::load_classes(env, pdnav::jni::g_classes)) return JNI_ERR;
   return JNI_VERSION_1_6;
 }
