@@ -3,6 +3,7 @@
 // (fusion::Navigator, io::LogWriter, io::LogReader) and converts the result back.
 #include <jni.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -11,6 +12,8 @@
 #include "pdnav/fusion/navigator.h"
 #include "pdnav/io/log_reader.h"
 #include "pdnav/io/log_writer.h"
+#include "pdnav/route/walk_graph.h"
+#include "pdnav/terrain/dem.h"
 #include "sample_codec.h"
 
 namespace pdnav::jni {
@@ -355,6 +358,56 @@ void reader_close(JNIEnv* env, jclass, jlong handle) {
   });
 }
 
+// ---- map data for the screen (read once per file, not per output) ----------------------
+
+jdoubleArray to_java(JNIEnv* env, const std::vector<double>& v) {
+  jdoubleArray a = env->NewDoubleArray(static_cast<jsize>(v.size()));
+  if (a == nullptr) throw JavaError(kRuntime, "double[] allocation failed");
+  env->SetDoubleArrayRegion(a, 0, static_cast<jsize>(v.size()), v.data());
+  return a;
+}
+
+/// The walkway graph's edges as WGS84 polylines: lat, lon pairs, each edge ended by NaN, NaN.
+jdoubleArray graph_polylines(JNIEnv* env, jclass, jstring path) {
+  return guarded<jdoubleArray>(env, nullptr, [&] {
+    const route::WalkGraph g = route::WalkGraph::load(to_string(env, path, "path"));
+    std::vector<double> out;
+    auto add = [&](const Eigen::Vector2d& en) {
+      const geo::Geodetic p = g.frame().to_geodetic(geo::Enu(en.x(), en.y(), 0.0));
+      out.push_back(p.lat_deg());
+      out.push_back(p.lon_deg());
+    };
+    const double nan = std::nan("");
+    for (std::size_t e = 0; e < g.edge_count(); ++e) {
+      const auto& edge = g.edge(static_cast<std::int32_t>(e));
+      add(g.node_en_m(edge.from));
+      for (const auto& q : edge.shape_en_m) add(q);
+      add(g.node_en_m(edge.to));
+      out.push_back(nan);
+      out.push_back(nan);
+    }
+    return to_java(env, out);
+  });
+}
+
+/// A DEM tile's WGS84 bounds: min lat, min lon, max lat, max lon (of its ENU corners).
+jdoubleArray dem_bounds(JNIEnv* env, jclass, jstring path) {
+  return guarded<jdoubleArray>(env, nullptr, [&] {
+    const terrain::Dem d = terrain::Dem::load(to_string(env, path, "path"));
+    double lat0 = 90, lon0 = 180, lat1 = -90, lon1 = -180;
+    for (double e : {d.min_e_m(), d.max_e_m()}) {
+      for (double n : {d.min_n_m(), d.max_n_m()}) {
+        const geo::Geodetic p = d.frame().to_geodetic(geo::Enu(e, n, 0.0));
+        lat0 = std::min(lat0, p.lat_deg());
+        lat1 = std::max(lat1, p.lat_deg());
+        lon0 = std::min(lon0, p.lon_deg());
+        lon1 = std::max(lon1, p.lon_deg());
+      }
+    }
+    return to_java(env, {lat0, lon0, lat1, lon1});
+  });
+}
+
 #define PDNAV_BATCH_SIG "I[I[J[J[D[Ljava/lang/String;[B"
 
 const JNINativeMethod kMethods[] = {
@@ -378,6 +431,8 @@ const JNINativeMethod kMethods[] = {
     {const_cast<char*>("readerStats"), const_cast<char*>("(J)[J"), reinterpret_cast<void*>(&reader_stats)},
     {const_cast<char*>("readerProgress"), const_cast<char*>("(J)D"), reinterpret_cast<void*>(&reader_progress)},
     {const_cast<char*>("readerClose"), const_cast<char*>("(J)V"), reinterpret_cast<void*>(&reader_close)},
+    {const_cast<char*>("graphPolylines"), const_cast<char*>("(Ljava/lang/String;)[D"), reinterpret_cast<void*>(&graph_polylines)},
+    {const_cast<char*>("demBounds"), const_cast<char*>("(Ljava/lang/String;)[D"), reinterpret_cast<void*>(&dem_bounds)},
 };
 
 }  // namespace

@@ -22,7 +22,9 @@ class Utf8AndCleanupTest {
         check(System.getProperty("sun.jnu.encoding").equals("UTF-8", ignoreCase = true)) {
             "the JVM must name files in UTF-8 (surefire sets LC_ALL=C.UTF-8), got ${System.getProperty("sun.jnu.encoding")}"
         }
-        val dir = TestPaths.scratch("utf8")
+        // a fresh folder per run: a broken bridge leaves a file whose name is not valid UTF-8,
+        // which the next run could not delete
+        val dir = TestPaths.scratch("utf8-${System.nanoTime()}")
         val file = File(dir, "séance_$emoji 日本.txt")
         val value = "Wanderung $emoji über den Pass"
         NativeRecorder(file.path, "Pixel $emoji").use { r ->
@@ -46,6 +48,7 @@ class Utf8AndCleanupTest {
         val missing = File(dir, "fehlt_$emoji.txt").path
         val e = assertFailsWith<IOException> { NativeLogReader(missing) }
         assertTrue(e.message?.contains("fehlt_$emoji") == true, "error message keeps the path: ${e.message}")
+        dir.deleteRecursively()
     }
 
     @Test

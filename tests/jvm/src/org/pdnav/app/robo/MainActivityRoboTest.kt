@@ -124,6 +124,35 @@ class MainActivityRoboTest {
     }
 
     @Test
+    fun locationSwitchedOffShowsAPromptThatOpensTheLocationSettings() {
+        shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACCESS_COARSE_LOCATION)
+        val lm = app.getSystemService(android.location.LocationManager::class.java)
+        shadowOf(lm).setLocationEnabled(false)
+        val activity = Robolectric.buildActivity(MainActivity::class.java).setup().get()
+        assertEquals(View.VISIBLE, activity.findViewById<View>(R.id.location_panel).visibility, "prompt shown")
+        activity.findViewById<Button>(R.id.location_settings).performClick()
+        assertEquals(android.provider.Settings.ACTION_LOCATION_SOURCE_SETTINGS, shadowOf(activity).nextStartedActivity?.action)
+        shadowOf(lm).setLocationEnabled(true)
+        val again = Robolectric.buildActivity(MainActivity::class.java).setup().get()
+        assertEquals(View.GONE, again.findViewById<View>(R.id.location_panel).visibility, "no prompt when location is on")
+    }
+
+    @Test
+    fun withoutABasemapTheMapOpensOnTheDemAndDrawsTheWalkwayGraph() {
+        shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACCESS_COARSE_LOCATION)
+        val root = java.io.File(System.getProperty("pdnav.root") ?: error("pdnav.root not set"))
+        val s = AppSettings(app.getSharedPreferences(AppSettings.PREFS, android.content.Context.MODE_PRIVATE))
+        s.graphPath = java.io.File(root, "tests/fuzz-corpus/graph_reader/small_l.graph").path
+        s.demPath = java.io.File(root, "tests/fuzz-corpus/dem_reader/andorra_4x4.pdem").path
+        val activity = Robolectric.buildActivity(MainActivity::class.java).setup().get()
+        assertNotNull(activity.mapDataThread).join(10_000)
+        shadowOf(android.os.Looper.getMainLooper()).idle()
+        assertEquals(2, activity.map.graphEdgeCount, "both edges of the graph drawn")
+        assertEquals(42.55, activity.map.centerLatDeg, 1e-4, "centred on the DEM tile")
+        assertEquals(1.55, activity.map.centerLonDeg, 1e-4)
+    }
+
+    @Test
     fun aLongPressStartGoesToTheNextSessionOnlyAndNothingIsSaved() {
         shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACCESS_COARSE_LOCATION)
         val activity = Robolectric.buildActivity(MainActivity::class.java).setup().get()

@@ -93,6 +93,30 @@ class MapController(context: Context, val map: MapView) {
         }
     }
 
+    private val graphLines = mutableListOf<Polyline>()
+
+    /**
+     * The walkway graph (what the route engine matches against) drawn over the basemap's
+     * hillshade, below the track and the estimate.
+     */
+    fun showGraph(lines: List<List<DoubleArray>>) {
+        map.overlays.removeAll(graphLines.toSet())
+        graphLines.clear()
+        val at = map.overlays.indexOf(trackLine).coerceAtLeast(0)
+        for (l in lines) {
+            val p = Polyline(map)
+            p.outlinePaint.color = Color.argb(200, 90, 90, 90)
+            p.outlinePaint.strokeWidth = 2.5f * density
+            p.setPoints(l.map { GeoPoint(it[0], it[1]) })
+            p.infoWindow = null
+            graphLines += p
+        }
+        map.overlays.addAll(at, graphLines)
+        map.invalidate()
+    }
+
+    val graphEdgeCount: Int get() = graphLines.size
+
     /** Area the basemap covers, once loaded. */
     var basemapBounds: GeoBounds? = null
         private set

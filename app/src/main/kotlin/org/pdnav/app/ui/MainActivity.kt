@@ -26,6 +26,7 @@ import android.widget.TextView
 import org.osmdroid.views.MapView
 import org.pdnav.app.R
 import org.pdnav.app.map.MapController
+import org.pdnav.app.map.MapData
 import org.pdnav.app.nav.NavOutput
 import org.pdnav.app.sensors.NavigationService
 import org.pdnav.app.sensors.SessionStats
@@ -60,6 +61,11 @@ class MainActivity : Activity() {
     private var bound = false
     private var asked = false
     private var pendingReplay: String? = null
+    private var mapDataKey: String? = null
+
+    /** The background load of the graph / DEM bounds (tests join it). */
+    @Volatile var mapDataThread: Thread? = null
+        private set
 
     /** The start declared by a long-press before Navigate: used by the next session only. */
     var pendingStart: DoubleArray? = null
@@ -130,10 +136,12 @@ class MainActivity : Activity() {
     override fun onStart() {
         super.onStart()
         val basemap = settings.basemapPath.takeIf { it.isNotEmpty() }?.let(::File)
-        if (!mapController.loadBasemap(this, basemap)) {
+        val hasBasemap = mapController.loadBasemap(this, basemap)
+        if (!hasBasemap) {
             status.text = getString(R.string.status_no_basemap)
             centerOnLastFix()
         }
+        loadMapData(centerOnDem = !hasBasemap)
         bound = bindService(Intent(this, NavigationService::class.java), connection, Context.BIND_AUTO_CREATE)
     }
 
@@ -308,6 +316,24 @@ class MainActivity : Activity() {
         val ok = service?.checkpoint(latDeg, lonDeg) == true
         status.text = if (ok) getString(R.string.checkpoint_written, latDeg, lonDeg) else getString(R.string.checkpoint_no_session)
         return ok
+    }
+
+    /** Walkway graph and DEM bounds, read on a thread (once per pair of files). */
+    private fun loadMapData(centerOnDem: Boolean) {
+        val graph = settings.graphPath
+        val dem = settings.demPath
+        val key = "$graph|$dem"
+        if (key == mapDataKey || (graph.isEmpty() && dem.isEmpty())) return
+        mapDataKey = key
+        mapDataThread = Thread({
+            val data = MapData.load(graph, dem)
+            runOnUiThread {
+                mapController.showGraph(data.graphLines)
+                val b = data.demBounds
+                if (centerOnDem && b != null) mapController.centerOn(b)
+                data.error?.let { status.text = getString(R.string.status_error, it) }
+            }
+        }, "pdnav-mapdata").apply { start() }
     }
 
     private fun centerOnLastFix() {
