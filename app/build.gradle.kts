@@ -23,12 +23,19 @@ android {
         externalNativeBuild {
             cmake {
                 // Only the core and the bridge: host tools, tests and benchmarks are off.
+                // c++_static: libpdnav_jni.so is the only native library, so the STL is
+                // linked into it (no libc++_shared.so to ship, no ODR clash possible).
                 arguments += listOf(
                     "-DPDNAV_BUILD_TESTS=OFF",
                     "-DPDNAV_BUILD_BENCHMARKS=OFF",
                     "-DPDNAV_BUILD_JVM_TESTS=OFF",
-                    "-DANDROID_STL=c++_shared",
+                    "-DANDROID_STL=c++_static",
                 )
+                // Without network: FetchContent takes these local sources instead (gradle.properties).
+                val eigen = providers.gradleProperty("pdnav.eigenDir").orNull.orEmpty()
+                val fastFloat = providers.gradleProperty("pdnav.fastFloatDir").orNull.orEmpty()
+                if (eigen.isNotEmpty()) arguments += "-DFETCHCONTENT_SOURCE_DIR_EIGEN=$eigen"
+                if (fastFloat.isNotEmpty()) arguments += "-DFETCHCONTENT_SOURCE_DIR_FAST_FLOAT=$fastFloat"
                 targets += listOf("pdnav_jni")
             }
         }
@@ -59,19 +66,18 @@ android {
         sourceCompatibility = JavaVersion.VERSION_17
         targetCompatibility = JavaVersion.VERSION_17
     }
+}
 
-    testOptions {
-        unitTests.isIncludeAndroidResources = true
+// No jvmToolchain pin (it would need a toolchain resolver to download a JDK): the JDK that
+// runs Gradle (17+) compiles, targeting Java 17 bytecode.
+kotlin {
+    compilerOptions {
+        jvmTarget.set(org.jetbrains.kotlin.gradle.dsl.JvmTarget.JVM_17)
     }
 }
 
-kotlin {
-    jvmToolchain(17)
-}
-
+// The unit tests (JUnit + Robolectric, tests/jvm) run on the host through
+// tools/android-host/run, which needs the host-built libpdnav_jni.so; Gradle has none here.
 dependencies {
     implementation(libs.osmdroid)
-    testImplementation(libs.junit)
-    testImplementation(libs.robolectric)
-    testImplementation(libs.kotlin.test.junit)
 }

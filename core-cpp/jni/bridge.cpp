@@ -3,6 +3,7 @@
 // (fusion::Navigator, io::LogWriter, io::LogReader) and converts the result back.
 #include <jni.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -11,6 +12,8 @@
 #include "pdnav/fusion/navigator.h"
 #include "pdnav/io/log_reader.h"
 #include "pdnav/io/log_writer.h"
+#include "pdnav/route/walk_graph.h"
+#include "pdnav/terrain/dem.h"
 #include "sample_codec.h"
 
 namespace pdnav::jni {
@@ -32,17 +35,39 @@ JavaBatchArrays arrays(jintArray k, jlongArray t, jlongArray i, jdoubleArray d, 
   return JavaBatchArrays{k, t, i, d, s, b};
 }
 
-jclass find_class(JNIEnv* env, const char* name) {
-  jclass c = env->FindClass(name);
-  if (c == nullptr) throw JavaError(kRuntime, std::string("class not found: ") + name);
-  return c;
+/// Classes and constructors the bridge builds, looked up once in JNI_OnLoad (global
+/// references; read-only afterwards). FindClass per call is slow, and on a thread the
+/// native side attached itself it would search the system class loader, not the app's.
+struct ClassCache {
+  jclass estimate = nullptr;
+  jclass output = nullptr;
+  jclass string = nullptr;
+  jmethodID estimate_ctor = nullptr;
+  jmethodID output_ctor = nullptr;
+};
+ClassCache g_classes;  // set once at load, before any native can run
+
+bool load_classes(JNIEnv* env, ClassCache& c) {
+  auto global = [env](const char* name) -> jclass {
+    jclass local = env->FindClass(name);
+    if (local == nullptr) return nullptr;
+    auto g = static_cast<jclass>(env->NewGlobalRef(local));
+    env->DeleteLocalRef(local);
+    return g;
+  };
+  c.estimate = global(kEstimateClass);
+  c.output = global(kOutputClass);
+  c.string = global("java/lang/String");
+  if (c.estimate == nullptr || c.output == nullptr || c.string == nullptr) return false;
+  c.estimate_ctor = env->GetMethodID(c.estimate, "<init>", kEstimateCtor);
+  c.output_ctor = env->GetMethodID(c.output, "<init>", kOutputCtor);
+  return c.estimate_ctor != nullptr && c.output_ctor != nullptr;
 }
 
 jobject new_estimate(JNIEnv* env, const Estimate& e) {
-  jclass c = find_class(env, kEstimateClass);
-  jmethodID ctor = env->GetMethodID(c, "<init>", kEstimateCtor);
-  if (ctor == nullptr) throw JavaError(kRuntime, "NavEstimate constructor not found");
-  jstring reason = env->NewStringUTF(e.reason.c_str());
+  jclass c = g_classes.estimate;
+  jmethodID ctor = g_classes.estimate_ctor;
+  jstring reason = new_string(env, e.reason);
   const bool has_position = e.status != EstimateStatus::kNotInitialized;
   const double nan = std::nan("");
   jobject o = env->NewObject(c, ctor, static_cast<jlong>(e.t_ns), static_cast<jint>(e.engine),
@@ -53,7 +78,6 @@ jobject new_estimate(JNIEnv* env, const Estimate& e) {
                              e.cov_en_m2(0, 0), e.cov_en_m2(0, 1), e.cov_en_m2(1, 1),
                              e.vertical_sigma_m);
   env->DeleteLocalRef(reason);
-  env->DeleteLocalRef(c);
   if (o == nullptr) throw JavaError(kRuntime, "NavEstimate allocation failed");
   return o;
 }
@@ -71,14 +95,13 @@ jintArray layout(JNIEnv* env, jclass) {
 }
 
 jobjectArray names(JNIEnv* env, const std::vector<std::string>& v) {
-  jclass sc = find_class(env, "java/lang/String");
-  jobjectArray a = env->NewObjectArray(static_cast<jsize>(v.size()), sc, nullptr);
+  jobjectArray a = env->NewObjectArray(static_cast<jsize>(v.size()), g_classes.string, nullptr);
+  if (a == nullptr) throw JavaError(kRuntime, "String[] allocation failed");
   for (std::size_t i = 0; i < v.size(); ++i) {
-    jstring s = env->NewStringUTF(v[i].c_str());
+    jstring s = new_string(env, v[i]);
     env->SetObjectArrayElement(a, static_cast<jsize>(i), s);
     env->DeleteLocalRef(s);
   }
-  env->DeleteLocalRef(sc);
   return a;
 }
 
@@ -178,8 +201,8 @@ jobject nav_output(JNIEnv* env, jclass, jlong handle, jint max_particles) {
       out = h.object.output(static_cast<std::size_t>(max_particles));
     }
     jobject best = new_estimate(env, out.estimate);
-    jclass ec = find_class(env, kEstimateClass);
-    jobjectArray engines = env->NewObjectArray(static_cast<jsize>(out.engines.size()), ec, nullptr);
+    jobjectArray engines =
+        env->NewObjectArray(static_cast<jsize>(out.engines.size()), g_classes.estimate, nullptr);
     for (std::size_t i = 0; i < out.engines.size(); ++i) {
       jobject e = new_estimate(env, out.engines[i]);
       env->SetObjectArrayElement(engines, static_cast<jsize>(i), e);
@@ -193,12 +216,8 @@ jobject nav_output(JNIEnv* env, jclass, jlong handle, jint max_particles) {
     }
     jdoubleArray particles = env->NewDoubleArray(static_cast<jsize>(en.size()));
     env->SetDoubleArrayRegion(particles, 0, static_cast<jsize>(en.size()), en.data());
-    jclass oc = find_class(env, kOutputClass);
-    jmethodID ctor = env->GetMethodID(oc, "<init>", kOutputCtor);
-    if (ctor == nullptr) throw JavaError(kRuntime, "NavOutput constructor not found");
-    jobject o = env->NewObject(oc, ctor, best, engines, static_cast<jlong>(out.steps), particles);
-    env->DeleteLocalRef(ec);
-    env->DeleteLocalRef(oc);
+    jobject o = env->NewObject(g_classes.output, g_classes.output_ctor, best, engines,
+                               static_cast<jlong>(out.steps), particles);
     return o;
   });
 }
@@ -359,6 +378,56 @@ void reader_close(JNIEnv* env, jclass, jlong handle) {
   });
 }
 
+// ---- map data for the screen (read once per file, not per output) ----------------------
+
+jdoubleArray to_java(JNIEnv* env, const std::vector<double>& v) {
+  jdoubleArray a = env->NewDoubleArray(static_cast<jsize>(v.size()));
+  if (a == nullptr) throw JavaError(kRuntime, "double[] allocation failed");
+  env->SetDoubleArrayRegion(a, 0, static_cast<jsize>(v.size()), v.data());
+  return a;
+}
+
+/// The walkway graph's edges as WGS84 polylines: lat, lon pairs, each edge ended by NaN, NaN.
+jdoubleArray graph_polylines(JNIEnv* env, jclass, jstring path) {
+  return guarded<jdoubleArray>(env, nullptr, [&] {
+    const route::WalkGraph g = route::WalkGraph::load(to_string(env, path, "path"));
+    std::vector<double> out;
+    auto add = [&](const Eigen::Vector2d& en) {
+      const geo::Geodetic p = g.frame().to_geodetic(geo::Enu(en.x(), en.y(), 0.0));
+      out.push_back(p.lat_deg());
+      out.push_back(p.lon_deg());
+    };
+    const double nan = std::nan("");
+    for (std::size_t e = 0; e < g.edge_count(); ++e) {
+      const auto& edge = g.edge(static_cast<std::int32_t>(e));
+      add(g.node_en_m(edge.from));
+      for (const auto& q : edge.shape_en_m) add(q);
+      add(g.node_en_m(edge.to));
+      out.push_back(nan);
+      out.push_back(nan);
+    }
+    return to_java(env, out);
+  });
+}
+
+/// A DEM tile's WGS84 bounds: min lat, min lon, max lat, max lon (of its ENU corners).
+jdoubleArray dem_bounds(JNIEnv* env, jclass, jstring path) {
+  return guarded<jdoubleArray>(env, nullptr, [&] {
+    const terrain::Dem d = terrain::Dem::load(to_string(env, path, "path"));
+    double lat0 = 90, lon0 = 180, lat1 = -90, lon1 = -180;
+    for (double e : {d.min_e_m(), d.max_e_m()}) {
+      for (double n : {d.min_n_m(), d.max_n_m()}) {
+        const geo::Geodetic p = d.frame().to_geodetic(geo::Enu(e, n, 0.0));
+        lat0 = std::min(lat0, p.lat_deg());
+        lat1 = std::max(lat1, p.lat_deg());
+        lon0 = std::min(lon0, p.lon_deg());
+        lon1 = std::max(lon1, p.lon_deg());
+      }
+    }
+    return to_java(env, {lat0, lon0, lat1, lon1});
+  });
+}
+
 #define PDNAV_BATCH_SIG "I[I[J[J[D[Ljava/lang/String;[B"
 
 const JNINativeMethod kMethods[] = {
@@ -383,6 +452,8 @@ const JNINativeMethod kMethods[] = {
     {const_cast<char*>("readerStats"), const_cast<char*>("(J)[J"), reinterpret_cast<void*>(&reader_stats)},
     {const_cast<char*>("readerProgress"), const_cast<char*>("(J)D"), reinterpret_cast<void*>(&reader_progress)},
     {const_cast<char*>("readerClose"), const_cast<char*>("(J)V"), reinterpret_cast<void*>(&reader_close)},
+    {const_cast<char*>("graphPolylines"), const_cast<char*>("(Ljava/lang/String;)[D"), reinterpret_cast<void*>(&graph_polylines)},
+    {const_cast<char*>("demBounds"), const_cast<char*>("(Ljava/lang/String;)[D"), reinterpret_cast<void*>(&dem_bounds)},
 };
 
 }  // namespace
@@ -396,5 +467,6 @@ extern "C" JNIEXPORT jint JNI_OnLoad(JavaVM* vm, void*) {
   const auto n = static_cast<jint>(sizeof(pdnav::jni::kMethods) / sizeof(pdnav::jni::kMethods[0]));
   if (env->RegisterNatives(c, pdnav::jni::kMethods, n) != JNI_OK) return JNI_ERR;
   env->DeleteLocalRef(c);
+  if (!pdnav::jni::load_classes(env, pdnav::jni::g_classes)) return JNI_ERR;
   return JNI_VERSION_1_6;
 }

@@ -12,8 +12,20 @@ void throw_java(JNIEnv* env, const char* cls, const std::string& msg) noexcept {
   if (env->ExceptionCheck()) return;  // keep the exception the JVM already raised
   jclass c = env->FindClass(cls);
   if (c == nullptr) return;  // FindClass left NoClassDefFoundError pending
-  env->ThrowNew(c, msg.c_str());
-  env->DeleteLocalRef(c);
+  // Not ThrowNew: it takes Modified UTF-8, and a message naming a file with an emoji would
+  // abort a CheckJNI (debuggable) build. Build the message through UTF-16 instead.
+  jmethodID ctor = env->GetMethodID(c, "<init>", "(Ljava/lang/String;)V");
+  const std::vector<jchar> units = utf8_to_utf16(msg);
+  jstring jmsg = ctor != nullptr ? env->NewString(units.data(), static_cast<jsize>(units.size())) : nullptr;
+  if (jmsg != nullptr) {
+    auto e = static_cast<jthrowable>(env->NewObject(c, ctor, jmsg));
+    if (e != nullptr) {
+      env->Throw(e);
+      env->DeleteLocalRef(e);
+    }
+    env->DeleteLocalRef(jmsg);
+  }
+  env->DeleteLocalRef(c);  // on any failure above the JVM has an exception (OOM) pending
 }
 
 /// A JNI call failed and left a Java exception pending: unwind without adding another.
@@ -65,13 +77,110 @@ void throw_current_as_java(JNIEnv* env) noexcept {
   }
 }
 
+namespace {
+constexpr std::uint32_t kReplacement = 0xFFFD;
+
+void append_utf8(std::string& out, std::uint32_t cp) {
+  if (cp < 0x80) {
+    out.push_back(static_cast<char>(cp));
+  } else if (cp < 0x800) {
+    out.push_back(static_cast<char>(0xC0 | (cp >> 6)));
+    out.push_back(static_cast<char>(0x80 | (cp & 0x3F)));
+  } else if (cp < 0x10000) {
+    out.push_back(static_cast<char>(0xE0 | (cp >> 12)));
+    out.push_back(static_cast<char>(0x80 | ((cp >> 6) & 0x3F)));
+    out.push_back(static_cast<char>(0x80 | (cp & 0x3F)));
+  } else {
+    out.push_back(static_cast<char>(0xF0 | (cp >> 18)));
+    out.push_back(static_cast<char>(0x80 | ((cp >> 12) & 0x3F)));
+    out.push_back(static_cast<char>(0x80 | ((cp >> 6) & 0x3F)));
+    out.push_back(static_cast<char>(0x80 | (cp & 0x3F)));
+  }
+}
+
+bool is_high(std::uint32_t u) { return u >= 0xD800 && u <= 0xDBFF; }
+bool is_low(std::uint32_t u) { return u >= 0xDC00 && u <= 0xDFFF; }
+}  // namespace
+
+std::string utf16_to_utf8(const jchar* s, std::size_t n) {
+  std::string out;
+  out.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t u = s[i];
+    if (is_high(u) && i + 1 < n && is_low(s[i + 1])) {
+      append_utf8(out, 0x10000 + ((u - 0xD800) << 10) + (static_cast<std::uint32_t>(s[i + 1]) - 0xDC00));
+      ++i;
+    } else if (is_high(u) || is_low(u)) {
+      append_utf8(out, kReplacement);  // unpaired surrogate
+    } else {
+      append_utf8(out, u);
+    }
+  }
+  return out;
+}
+
+std::vector<jchar> utf8_to_utf16(const std::string& s) {
+  std::vector<jchar> out;
+  out.reserve(s.size());
+  const auto* p = reinterpret_cast<const unsigned char*>(s.data());
+  const std::size_t n = s.size();
+  std::size_t i = 0;
+  while (i < n) {
+    const unsigned char c = p[i];
+    std::uint32_t cp = kReplacement;
+    std::size_t len = 1;
+    std::uint32_t min = 0;
+    if (c < 0x80) {
+      cp = c;
+    } else if ((c & 0xE0) == 0xC0) {
+      len = 2, cp = c & 0x1F, min = 0x80;
+    } else if ((c & 0xF0) == 0xE0) {
+      len = 3, cp = c & 0x0F, min = 0x800;
+    } else if ((c & 0xF8) == 0xF0) {
+      len = 4, cp = c & 0x07, min = 0x10000;
+    } else {
+      len = 0;  // stray continuation or invalid lead byte
+    }
+    if (len == 0) {
+      cp = kReplacement;
+      len = 1;
+    } else if (len > 1) {
+      bool ok = i + len <= n;
+      for (std::size_t k = 1; ok && k < len; ++k) {
+        if ((p[i + k] & 0xC0) != 0x80) ok = false;
+        else cp = (cp << 6) | (p[i + k] & 0x3F);
+      }
+      if (!ok || cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) {
+        cp = kReplacement;
+        len = 1;  // resynchronise on the next byte
+      }
+    }
+    if (cp >= 0x10000) {
+      cp -= 0x10000;
+      out.push_back(static_cast<jchar>(0xD800 + (cp >> 10)));
+      out.push_back(static_cast<jchar>(0xDC00 + (cp & 0x3FF)));
+    } else {
+      out.push_back(static_cast<jchar>(cp));
+    }
+    i += len;
+  }
+  return out;
+}
+
 std::string to_string(JNIEnv* env, jstring s, const char* what) {
   if (s == nullptr) throw JavaError(kIllegalArgument, std::string(what) + " is null");
-  const char* utf = env->GetStringUTFChars(s, nullptr);
-  if (utf == nullptr) throw JavaPending();
-  std::string out(utf);
-  env->ReleaseStringUTFChars(s, utf);
-  return out;
+  const jsize n = env->GetStringLength(s);
+  std::vector<jchar> units(static_cast<std::size_t>(n));
+  if (n > 0) env->GetStringRegion(s, 0, n, units.data());
+  check_pending(env);
+  return utf16_to_utf8(units.data(), units.size());
+}
+
+jstring new_string(JNIEnv* env, const std::string& utf8) {
+  const std::vector<jchar> units = utf8_to_utf16(utf8);
+  jstring s = env->NewString(units.data(), static_cast<jsize>(units.size()));
+  if (s == nullptr) throw JavaPending();
+  return s;
 }
 
 std::vector<std::string> to_strings(JNIEnv* env, jobjectArray a, const char* what) {
@@ -144,8 +253,7 @@ void OutBatch::copy_to(JNIEnv* env, std::size_t n, const JavaBatchArrays& a) con
   env->SetByteArrayRegion(a.bytes, 0, static_cast<jsize>(n * kBytes), reinterpret_cast<const jbyte*>(b.bytes.data()));
   check_pending(env);
   for (std::size_t i = 0; i < n * kStrings; ++i) {
-    jstring s = env->NewStringUTF(b.strings[i].c_str());
-    check_pending(env);
+    jstring s = new_string(env, b.strings[i]);
     env->SetObjectArrayElement(a.strings, static_cast<jsize>(i), s);
     check_pending(env);
     env->DeleteLocalRef(s);

@@ -68,7 +68,18 @@ Handle<T>& from_handle(jlong handle, const char* what) {
 }
 
 /// Java string -> UTF-8 std::string; null -> IllegalArgumentException naming `what`.
+/// Goes through the string's UTF-16 code units (GetStringRegion), never JNI's Modified UTF-8:
+/// a supplementary character (emoji) becomes its 4-byte UTF-8 form, so a file name opens the
+/// path the Kotlin side named; an unpaired surrogate becomes U+FFFD.
 std::string to_string(JNIEnv* env, jstring s, const char* what);
+/// UTF-8 std::string -> Java string through UTF-16 (NewString, never NewStringUTF, which
+/// needs Modified UTF-8 and aborts a CheckJNI build on a 4-byte sequence). Invalid UTF-8
+/// bytes become U+FFFD. Throws JavaPending when the allocation failed.
+jstring new_string(JNIEnv* env, const std::string& utf8);
+
+/// Standard UTF-8 <-> UTF-16 conversions (replacement character for invalid input).
+std::string utf16_to_utf8(const jchar* s, std::size_t n);
+std::vector<jchar> utf8_to_utf16(const std::string& s);
 /// Java String[] -> vector; null array or element -> IllegalArgumentException.
 std::vector<std::string> to_strings(JNIEnv* env, jobjectArray a, const char* what);
 

@@ -173,8 +173,8 @@ class BridgeMisuseTest {
 
     /** The raw handle inside a NativeNavigator (for raw-array misuse tests only). */
     private fun handleOf(nav: NativeNavigator): Long {
-        val f = NativeNavigator::class.java.getDeclaredField("handle")
+        val f = NativeNavigator::class.java.getDeclaredField("h")
         f.isAccessible = true
-        return f.getLong(nav)
+        return (f.get(nav) as NativeHandle).get()
     }
 }

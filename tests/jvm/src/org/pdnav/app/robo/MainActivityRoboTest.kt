@@ -11,6 +11,8 @@ import org.pdnav.app.R
 import org.pdnav.app.map.MapController
 import org.pdnav.app.nav.NavEstimate
 import org.pdnav.app.nav.NavOutput
+import org.pdnav.app.sensors.NavigationService
+import org.pdnav.app.ui.AppSettings
 import org.pdnav.app.ui.MainActivity
 import org.robolectric.Robolectric
 import org.robolectric.RobolectricTestRunner
@@ -21,6 +23,7 @@ import kotlin.math.abs
 import kotlin.test.assertEquals
 import kotlin.test.assertFalse
 import kotlin.test.assertNotNull
+import kotlin.test.assertNull
 import kotlin.test.assertTrue
 
 /** The map screen under Robolectric (osmdroid views on the aapt2-linked resources). */
@@ -35,6 +38,7 @@ class MainActivityRoboTest {
         val request = assertNotNull(shadowOf(activity).lastRequestedPermission, "permissions requested at start")
         assertTrue(Manifest.permission.ACCESS_FINE_LOCATION in request.requestedPermissions)
         assertTrue(Manifest.permission.ACTIVITY_RECOGNITION in request.requestedPermissions)
+        assertTrue(Manifest.permission.POST_NOTIFICATIONS in request.requestedPermissions)
         val panel = activity.findViewById<View>(R.id.permission_panel)
         assertEquals(View.GONE, panel.visibility, "no explanation before the answer")
 
@@ -59,6 +63,117 @@ class MainActivityRoboTest {
     }
 
     @Test
+    fun activityRecognitionIsOptionalAndNotificationsAreAskedWhenLocationIsGranted() {
+        shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACCESS_COARSE_LOCATION)
+        val activity = Robolectric.buildActivity(MainActivity::class.java).setup().get()
+        val request = assertNotNull(shadowOf(activity).lastRequestedPermission, "optional permissions asked too")
+        assertTrue(Manifest.permission.POST_NOTIFICATIONS in request.requestedPermissions, "notifications asked although location is granted")
+        activity.onRequestPermissionsResult(request.requestCode, request.requestedPermissions,
+            IntArray(request.requestedPermissions.size) { PackageManager.PERMISSION_DENIED })
+        assertEquals(View.GONE, activity.findViewById<View>(R.id.permission_panel).visibility, "activity recognition refused: GNSS-only is fine")
+        assertTrue(activity.findViewById<Button>(R.id.button_record).isEnabled, "recording possible without activity recognition")
+        assertTrue(activity.findViewById<TextView>(R.id.info_text).text.contains("step detector"), "the cost of the refusal is said")
+    }
+
+    @Test
+    fun theExplanationIsRecheckedAfterAGrantInSystemSettings() {
+        val controller = Robolectric.buildActivity(MainActivity::class.java).setup()
+        val activity = controller.get()
+        val request = assertNotNull(shadowOf(activity).lastRequestedPermission)
+        activity.onRequestPermissionsResult(request.requestCode, request.requestedPermissions,
+            IntArray(request.requestedPermissions.size) { PackageManager.PERMISSION_DENIED })
+        assertEquals(View.VISIBLE, activity.findViewById<View>(R.id.permission_panel).visibility)
+        // the user grants in the system settings and comes back
+        shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACCESS_COARSE_LOCATION)
+        controller.pause().resume()
+        assertEquals(View.GONE, activity.findViewById<View>(R.id.permission_panel).visibility, "explanation gone after the grant")
+        assertTrue(activity.findViewById<Button>(R.id.button_navigate).isEnabled)
+    }
+
+    @Test
+    fun theMapOpensOnTheBasemapAreaAndFollowCanBeSwitchedOff() {
+        shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACCESS_COARSE_LOCATION)
+        val f = java.io.File(app.filesDir, "data/basemap/test.mbtiles").apply { parentFile?.mkdirs(); delete() }
+        android.database.sqlite.SQLiteDatabase.openOrCreateDatabase(f, null).use { db ->
+            db.execSQL("CREATE TABLE metadata (name TEXT, value TEXT)")
+            db.execSQL("CREATE TABLE tiles (zoom_level INTEGER, tile_column INTEGER, tile_row INTEGER, tile_data BLOB)")
+            db.execSQL("INSERT INTO metadata VALUES ('name', 'test'), ('format', 'png'), ('bounds', '1.50,42.50,1.52,42.52')")
+        }
+        AppSettings(app.getSharedPreferences(AppSettings.PREFS, android.content.Context.MODE_PRIVATE)).basemapPath = f.path
+        val activity = Robolectric.buildActivity(MainActivity::class.java).setup().get()
+        val map = activity.map
+        assertEquals(42.51, map.centerLatDeg, 1e-4, "centred on the basemap, not on 0, 0")
+        assertEquals(1.51, map.centerLonDeg, 1e-4)
+        // Follow off: an output does not move the map
+        activity.findViewById<Button>(R.id.button_follow).performClick()
+        assertFalse(map.follow)
+        val e = NavEstimate(5_000_000_000L, 2, 1, "", 42.6, 1.6, 1500.0, 0.0, 0.0, 4.0, 0.0, 4.0, 3.0)
+        activity.showOutput(NavOutput(e, arrayOf(e), 1, DoubleArray(0)), listOf(doubleArrayOf(42.6, 1.6)))
+        assertEquals(42.51, map.centerLatDeg, 1e-4, "free map stays where it was")
+        activity.findViewById<Button>(R.id.button_follow).performClick()
+        activity.showOutput(NavOutput(e, arrayOf(e), 1, DoubleArray(0)), listOf(doubleArrayOf(42.6, 1.6)))
+        assertEquals(42.6, map.centerLatDeg, 1e-4, "following again")
+    }
+
+    /** The next ACTION_SET service start (the binding's plain intent is skipped). */
+    private fun nextSet(): android.content.Intent? {
+        while (true) {
+            val i = shadowOf(app).nextStartedService ?: return null
+            if (i.action == NavigationService.ACTION_SET) return i
+        }
+    }
+
+    @Test
+    fun locationSwitchedOffShowsAPromptThatOpensTheLocationSettings() {
+        shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACCESS_COARSE_LOCATION)
+        val lm = app.getSystemService(android.location.LocationManager::class.java)
+        shadowOf(lm).setLocationEnabled(false)
+        val activity = Robolectric.buildActivity(MainActivity::class.java).setup().get()
+        assertEquals(View.VISIBLE, activity.findViewById<View>(R.id.location_panel).visibility, "prompt shown")
+        activity.findViewById<Button>(R.id.location_settings).performClick()
+        assertEquals(android.provider.Settings.ACTION_LOCATION_SOURCE_SETTINGS, shadowOf(activity).nextStartedActivity?.action)
+        shadowOf(lm).setLocationEnabled(true)
+        val again = Robolectric.buildActivity(MainActivity::class.java).setup().get()
+        assertEquals(View.GONE, again.findViewById<View>(R.id.location_panel).visibility, "no prompt when location is on")
+    }
+
+    @Test
+    fun withoutABasemapTheMapOpensOnTheDemAndDrawsTheWalkwayGraph() {
+        shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACCESS_COARSE_LOCATION)
+        val root = java.io.File(System.getProperty("pdnav.root") ?: error("pdnav.root not set"))
+        val s = AppSettings(app.getSharedPreferences(AppSettings.PREFS, android.content.Context.MODE_PRIVATE))
+        s.graphPath = java.io.File(root, "tests/fuzz-corpus/graph_reader/small_l.graph").path
+        s.demPath = java.io.File(root, "tests/fuzz-corpus/dem_reader/andorra_4x4.pdem").path
+        val activity = Robolectric.buildActivity(MainActivity::class.java).setup().get()
+        assertNotNull(activity.mapDataThread).join(10_000)
+        shadowOf(android.os.Looper.getMainLooper()).idle()
+        assertEquals(2, activity.map.graphEdgeCount, "both edges of the graph drawn")
+        assertEquals(42.55, activity.map.centerLatDeg, 1e-4, "centred on the DEM tile")
+        assertEquals(1.55, activity.map.centerLonDeg, 1e-4)
+    }
+
+    @Test
+    fun aLongPressStartGoesToTheNextSessionOnlyAndNothingIsSaved() {
+        shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACCESS_COARSE_LOCATION)
+        val activity = Robolectric.buildActivity(MainActivity::class.java).setup().get()
+        activity.declareStart(42.5, 1.5)
+        activity.findViewById<Button>(R.id.button_navigate).performClick()
+        val first = assertNotNull(nextSet(), "Navigate started the service")
+        assertEquals(NavigationService.ACTION_SET, first.action)
+        assertEquals(42.5, first.getDoubleExtra(NavigationService.EXTRA_START_LAT, Double.NaN), 1e-12)
+        assertNull(activity.pendingStart, "consumed by that session")
+        activity.findViewById<Button>(R.id.button_navigate).performClick()  // (service not bound in the test: starts again)
+        val second = assertNotNull(nextSet(), "Navigate started the service again")
+        assertFalse(second.hasExtra(NavigationService.EXTRA_START_LAT), "a later session does not inherit the start")
+        val prefs = app.getSharedPreferences(AppSettings.PREFS, android.content.Context.MODE_PRIVATE)
+        assertFalse(prefs.all.keys.any { it.contains("lat") }, "no start in preferences: ${prefs.all.keys}")
+        // an old version's saved start is dropped
+        prefs.edit().putLong(AppSettings.OLD_KEY_LAT, 1L).commit()
+        assertTrue(AppSettings(prefs).navigatorConfig().startLatDeg.isNaN())
+        assertFalse(prefs.contains(AppSettings.OLD_KEY_LAT))
+    }
+
+    @Test
     fun anOutputDrawsMarkerEllipseTrackAndStatus() {
         shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACCESS_COARSE_LOCATION,
             Manifest.permission.ACTIVITY_RECOGNITION)
@@ -72,6 +187,9 @@ class MainActivityRoboTest {
         assertTrue(status.contains("terrain") && status.contains("GNSS lost, terrain engine") && status.contains("12 steps"), status)
         val map = activity.map
         assertTrue(map.markerShown)
+        assertEquals(1, map.engineCount, "each engine drawn")
+        val info = activity.findViewById<TextView>(R.id.info_text).text.toString()
+        assertTrue(info.contains("42.500000") && info.contains("1.500000") && info.contains("±") && info.contains("terrain"), info)
         assertEquals(36, map.ellipsePointCount)
         assertEquals(2, map.trackPointCount)
         // the 95 % ellipse reaches 2.4477 * 4 m east of the estimate

@@ -1,14 +1,20 @@
 package org.pdnav.app.robo
 
 import android.Manifest
+import android.app.NotificationManager
+import android.app.Service
 import android.hardware.Sensor
 import android.hardware.SensorManager
 import android.location.GnssClock
 import android.location.GnssMeasurement
 import android.location.GnssMeasurementsEvent
+import android.location.GnssStatus
 import android.location.Location
 import android.location.LocationManager
+import android.os.Looper
+import android.os.PowerManager
 import android.os.SystemClock
+import org.junit.Before
 import org.junit.Test
 import org.junit.runner.RunWith
 import org.pdnav.app.nav.NativeLogReader
@@ -16,33 +22,54 @@ import org.pdnav.app.nav.NavOutput
 import org.pdnav.app.nav.NavigatorConfig
 import org.pdnav.app.nav.SampleBatch
 import org.pdnav.app.nav.SampleKind
+import org.pdnav.app.nav.SampleSink
 import org.pdnav.app.recording.ReplayTask
+import org.pdnav.app.recording.SessionStore
 import org.pdnav.app.sensors.NavigationService
+import org.pdnav.app.sensors.NavigationSession
 import org.robolectric.Robolectric
 import org.robolectric.RobolectricTestRunner
 import org.robolectric.RuntimeEnvironment
 import org.robolectric.Shadows.shadowOf
 import org.robolectric.annotation.LooperMode
 import org.robolectric.shadows.SensorEventBuilder
+import org.robolectric.shadows.ShadowPowerManager
 import org.robolectric.shadows.ShadowSensor
 import org.robolectric.shadows.ShadowSystemClock
+import java.io.File
+import java.io.IOException
 import java.time.Duration
 import kotlin.test.assertEquals
+import kotlin.test.assertFalse
 import kotlin.test.assertNotNull
 import kotlin.test.assertNull
 import kotlin.test.assertTrue
 
 /**
- * The foreground service with injected SensorEvents (ShadowSensorManager) and
- * GnssMeasurementsEvents / fixes (ShadowLocationManager): the bridge receives one stream in
- * time order, the recording is written through NativeRecorder and replays in the app.
+ * The foreground service with injected SensorEvents (ShadowSensorManager) and GNSS
+ * measurements / status / fixes (ShadowLocationManager): one time-ordered stream reaches the
+ * bridge and the recording, the wake lock spans the session, a failing sink ends it cleanly,
+ * a declared start belongs to one session and is recorded, replay reproduces it.
  */
 @RunWith(RobolectricTestRunner::class)
 @LooperMode(LooperMode.Mode.PAUSED)
 class ServiceRoboTest {
     private val app = RuntimeEnvironment.getApplication()
     private val types = listOf(Sensor.TYPE_ACCELEROMETER, Sensor.TYPE_GYROSCOPE, Sensor.TYPE_MAGNETIC_FIELD,
-        Sensor.TYPE_ROTATION_VECTOR, Sensor.TYPE_PRESSURE, Sensor.TYPE_STEP_DETECTOR)
+        Sensor.TYPE_ROTATION_VECTOR, Sensor.TYPE_PRESSURE, Sensor.TYPE_STEP_DETECTOR, Sensor.TYPE_GYROSCOPE_UNCALIBRATED)
+    private lateinit var sm: SensorManager
+    private lateinit var lm: LocationManager
+    private lateinit var sensors: Map<Int, Sensor>
+
+    @Before
+    fun setUp() {
+        shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACTIVITY_RECOGNITION)
+        sm = app.getSystemService(SensorManager::class.java)
+        sensors = types.associateWith { ShadowSensor.newInstance(it).also { s -> shadowOf(sm).addSensor(s) } }
+        lm = app.getSystemService(LocationManager::class.java)
+        shadowOf(lm).setProviderEnabled(LocationManager.GPS_PROVIDER, true)
+        ShadowPowerManager.clearWakeLocks()
+    }
 
     private fun gnssEvent(tNs: Long, svids: List<Int>): GnssMeasurementsEvent {
         val clock = GnssClock().apply {
@@ -64,41 +91,74 @@ class ServiceRoboTest {
         return GnssMeasurementsEvent.Builder().setClock(clock).setMeasurements(ms).build()
     }
 
+    private fun send(type: Int, t: Long, values: FloatArray) = shadowOf(sm).sendSensorEventToListeners(
+        SensorEventBuilder.newBuilder().setSensor(sensors.getValue(type)).setTimestamp(t).setValues(values).build())
+
+    /** One second of 100 Hz motion data (streams overlapping in time) and two GNSS epochs. */
+    private fun injectSecond(t0: Long, n: Int = 100) {
+        for (k in 0 until n) send(Sensor.TYPE_ACCELEROMETER, t0 + k * 10_000_000L, floatArrayOf(0.1f * (k % 10), 0f, 9.81f))
+        for (k in 0 until n) send(Sensor.TYPE_GYROSCOPE, t0 + k * 10_000_000L, floatArrayOf(0f, 0.01f * k, 0f))
+        for (k in 0 until n step 2) send(Sensor.TYPE_MAGNETIC_FIELD, t0 + k * 10_000_000L, floatArrayOf(20f, -5f, -40f))
+        for (k in 0 until n step 2) send(Sensor.TYPE_ROTATION_VECTOR, t0 + k * 10_000_000L, floatArrayOf(0f, 0f, 0.3826834f, 0.9238795f, 0.1f))
+        for (k in 0 until n step 10) send(Sensor.TYPE_PRESSURE, t0 + k * 10_000_000L, floatArrayOf(1013.25f))
+        for (k in 0 until n step 10) send(Sensor.TYPE_GYROSCOPE_UNCALIBRATED, t0 + k * 10_000_000L, floatArrayOf(0f, 0.01f, 0f, 0.001f, 0.002f, 0.003f))
+        send(Sensor.TYPE_STEP_DETECTOR, t0 + 550_000_000L, floatArrayOf(1f))
+        shadowOf(lm).simulateGnssMeasurementsEvent(gnssEvent(t0 + 250_000_000L, listOf(3, 7, 12)))
+        shadowOf(lm).simulateGnssMeasurementsEvent(gnssEvent(t0 + 750_000_000L, listOf(3, 7)))
+    }
+
+    private fun wakeLock(): PowerManager.WakeLock? = ShadowPowerManager.getLatestWakeLock()
+
+    private fun idleWorker(service: NavigationService) {
+        service.workLooper?.let { shadowOf(it).idle() }
+        shadowOf(Looper.getMainLooper()).idle()
+    }
+
+    private fun stopAndJoin(service: NavigationService) {
+        val looper = service.workLooper
+        service.stopSession()
+        looper?.thread?.join(10_000)
+        assertTrue(looper == null || !looper.thread.isAlive, "worker thread ended")
+        shadowOf(Looper.getMainLooper()).idle()
+    }
+
+    private fun readAll(file: File): List<Triple<Int, Long, SampleBatch>> {
+        val rows = mutableListOf<Triple<Int, Long, SampleBatch>>()
+        NativeLogReader(file.path).use { r ->
+            while (true) {
+                val b = SampleBatch()
+                if (!r.read(b, 1000)) break
+                for (i in 0 until b.size) rows += Triple(b.kind(i), b.tNs(i), SampleBatch(1).apply { addCopy(b, i) })
+            }
+            assertEquals(0L, r.stats.skipped, "no line of the recording skipped")
+        }
+        return rows
+    }
+
     @Test
     fun sensorAndGnssEventsReachTheBridgeInTimeOrderAndTheRecordingReplays() {
-        shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACTIVITY_RECOGNITION)
-        val sm = app.getSystemService(SensorManager::class.java)
-        val sensors = types.associateWith { ShadowSensor.newInstance(it).also { s -> shadowOf(sm).addSensor(s) } }
-        val lm = app.getSystemService(LocationManager::class.java)
-        shadowOf(lm).setProviderEnabled(LocationManager.GPS_PROVIDER, true)
-
-        val service = Robolectric.buildService(NavigationService::class.java).create().get()
+        val controller = Robolectric.buildService(NavigationService::class.java).create()
+        val service = controller.get()
         val session = assertNotNull(service.startSession(navigate = true, record = true), service.lastError)
+        idleWorker(service)
+        assertNull(session.error)
+        assertTrue(session.navigating && session.recording)
         assertEquals(types.toSet(), session.sensorTypes.toSet(), "every sensor registered")
         assertNotNull(shadowOf(service).lastForegroundNotification, "runs as a foreground service")
         val registered = assertNotNull(session.gnssRegistered)
-        assertTrue(registered.measurements && registered.fixes, "GNSS callbacks registered: $registered")
-        val looper = assertNotNull(service.workLooper)
+        assertTrue(registered.measurements && registered.fixes && registered.status, "GNSS callbacks registered: $registered")
+        assertTrue(wakeLock()?.isHeld == true, "partial wake lock held while the session runs")
 
         val t0 = SystemClock.elapsedRealtimeNanos()
-        val n = 100  // 1 s at 100 Hz
-        fun send(type: Int, k: Int, values: FloatArray) = shadowOf(sm).sendSensorEventToListeners(
-            SensorEventBuilder.newBuilder().setSensor(sensors.getValue(type)).setTimestamp(t0 + k * 10_000_000L).setValues(values).build())
-        // Accelerometer first, then the gyroscope's whole batch: the two streams overlap in time.
-        for (k in 0 until n) send(Sensor.TYPE_ACCELEROMETER, k, floatArrayOf(0.1f * (k % 10), 0f, 9.81f))
-        for (k in 0 until n) send(Sensor.TYPE_GYROSCOPE, k, floatArrayOf(0f, 0.01f * k, 0f))
-        for (k in 0 until n step 2) send(Sensor.TYPE_MAGNETIC_FIELD, k, floatArrayOf(20f, -5f, -40f))
-        for (k in 0 until n step 2) send(Sensor.TYPE_ROTATION_VECTOR, k, floatArrayOf(0f, 0f, 0.3826834f, 0.9238795f, 0.1f))
-        for (k in 0 until n step 10) send(Sensor.TYPE_PRESSURE, k, floatArrayOf(1013.25f))
-        send(Sensor.TYPE_STEP_DETECTOR, 55, floatArrayOf(1f))
-        // GNSS epochs at 0.25 s and 0.75 s arrive after all the sensor data (as on a phone).
-        shadowOf(lm).simulateGnssMeasurementsEvent(gnssEvent(t0 + 250_000_000L, listOf(3, 7, 12)))
-        shadowOf(lm).simulateGnssMeasurementsEvent(gnssEvent(t0 + 750_000_000L, listOf(3, 7)))
+        injectSecond(t0)
+        val status = GnssStatus.Builder().addSatellite(GnssStatus.CONSTELLATION_GPS, 7, 41f, 55f, 120f, true, true, true,
+            true, 1.57542e9f, false, 0f).build()
+        shadowOf(lm).simulateGnssStatus(status)
         shadowOf(lm).simulateLocation(Location(LocationManager.GPS_PROVIDER).apply {
             latitude = 37.4; longitude = -122.08; accuracy = 4f; time = 1_700_000_000_000L
             elapsedRealtimeNanos = t0 + 500_000_000L
         })
-        shadowOf(looper).idle()
+        idleWorker(service)
 
         ShadowSystemClock.advanceBy(Duration.ofSeconds(3))
         session.pump()
@@ -106,44 +166,188 @@ class ServiceRoboTest {
         val ignored = nav.ignored()
         assertTrue(ignored.keys.none { it.contains("order") || it.contains("backward") }, "navigator saw out-of-order samples: $ignored")
         assertEquals(0L, session.merger.lateRows, "rows emitted out of time order")
+        assertNull(service.lastOutput, "no output() built while nobody listens")
+        val stats = session.stats()
+        assertEquals(2L, stats.gnssEpochs)
+        assertEquals(1, stats.satellites.size)
+        assertEquals(100L, stats.sensorRows["accel"])
         val file = assertNotNull(session.recordFile)
 
-        service.stopSession()  // runs on the worker thread, which then quits
-        looper.thread.join(10_000)
-        assertTrue(!looper.thread.isAlive, "worker thread ended")
+        stopAndJoin(service)
         assertNull(service.session)
+        assertFalse(wakeLock()?.isHeld == true, "wake lock released on stop")
 
-        // The recording: every injected sample, one time-ordered stream.
+        // The recording: every injected sample, one time-ordered stream, an end marker.
         val counts = mutableMapOf<Int, Int>()
         var lastT = Long.MIN_VALUE
         val svids = mutableListOf<Long>()
-        NativeLogReader(file.path).use { r ->
-            val b = SampleBatch()
-            while (r.read(b, 1000)) {
-                for (i in 0 until b.size) {
-                    assertTrue(b.tNs(i) >= lastT, "row time ${b.tNs(i)} < previous $lastT")
-                    lastT = b.tNs(i)
-                    counts.merge(b.kind(i), 1, Int::plus)
-                    if (b.kind(i) == SampleKind.GNSS_RAW) {
-                        svids += b.long(i, 5)
-                        assertEquals(30.0 + b.long(i, 5), b.double(i, 6), "Cn0 of svid ${b.long(i, 5)}")
-                    }
-                }
+        val rows = readAll(file)
+        for ((kind, t, b) in rows) {
+            if (kind != SampleKind.META) {
+                assertTrue(t >= lastT, "row time $t < previous $lastT")
+                lastT = t
             }
-            assertEquals(0L, r.stats.skipped)
+            counts.merge(kind, 1, Int::plus)
+            if (kind == SampleKind.GNSS_RAW) {
+                svids += b.long(0, 5)
+                assertEquals(30.0 + b.long(0, 5), b.double(0, 6), "Cn0 of svid ${b.long(0, 5)}")
+            }
+            if (kind == SampleKind.GNSS_STATUS) {
+                assertEquals(7L, b.long(0, 4)); assertEquals(1L, b.long(0, 5)); assertEquals(55.0, b.double(0, 3), 1e-4)
+            }
         }
-        assertEquals(n, counts[SampleKind.ACCEL]); assertEquals(n, counts[SampleKind.GYRO])
-        assertEquals(n / 2, counts[SampleKind.MAG]); assertEquals(n / 2, counts[SampleKind.ROTATION_VECTOR])
-        assertEquals(n / 10, counts[SampleKind.PRESSURE]); assertEquals(1, counts[SampleKind.STEP_DETECTOR])
+        assertEquals(100, counts[SampleKind.ACCEL]); assertEquals(100, counts[SampleKind.GYRO])
+        assertEquals(50, counts[SampleKind.MAG]); assertEquals(50, counts[SampleKind.ROTATION_VECTOR])
+        assertEquals(10, counts[SampleKind.PRESSURE]); assertEquals(1, counts[SampleKind.STEP_DETECTOR])
+        assertEquals(10, counts[SampleKind.UNCAL_GYRO], "uncalibrated gyroscope recorded")
+        assertEquals(1, counts[SampleKind.GNSS_STATUS], "Status line per satellite")
         assertEquals(listOf(3L, 7L, 12L, 3L, 7L), svids)
         assertEquals(1, counts[SampleKind.FIX])
-        assertTrue((counts[SampleKind.META] ?: 0) >= 2, "session metadata written")
+        val meta = rows.filter { it.first == SampleKind.META }.associate { it.third.string(0, 0) to it.third.string(0, 1) }
+        assertTrue("Device" in meta && "AndroidApi" in meta && "GnssFullTracking" in meta, "phone and GNSS capabilities recorded: $meta")
+        assertEquals("stopped", meta[NavigationSession.KEY_END], "end marker")
 
-        // ... and it replays in the app's replay task.
+        // ... and it replays in the app's replay task, in batches (not one JNI call per row).
         var done: NavOutput? = null
         var error: Exception? = null
-        ReplayTask(file.path, NavigatorConfig(), 1L, onProgress = { _, _ -> }, onDone = { o, e -> done = o; error = e }).run()
+        val task = ReplayTask(file.path, NavigatorConfig(), 1L, onProgress = { _, _ -> }, onDone = { o, e -> done = o; error = e })
+        task.run()
         assertNull(error)
         assertNotNull(done)
+        assertTrue(task.feedCalls in 1..5, "replay fed ${rows.size} rows in ${task.feedCalls} JNI calls")
+        controller.destroy()
+    }
+
+    @Test
+    fun aThrowingSinkEndsTheSessionCleanlyKeepsTheFileAndSaysWhy() {
+        for (failure in listOf<Throwable>(IOException("write failed: No space left on device"), UnsatisfiedLinkError("libpdnav_jni.so not found"))) {
+            ShadowPowerManager.clearWakeLocks()
+            val controller = Robolectric.buildService(NavigationService::class.java).create()
+            val service = controller.get()
+            val errors = mutableListOf<String>()
+            service.addListener(object : NavigationService.Listener {
+                override fun onOutput(output: NavOutput, track: List<DoubleArray>) = Unit
+                override fun onError(message: String) { errors += message }
+            })
+            var calls = 0
+            service.testSinks = listOf(object : SampleSink {
+                override fun write(batch: SampleBatch) {
+                    calls++
+                    when (failure) {
+                        is IOException -> throw failure
+                        is Error -> throw failure
+                    }
+                }
+            })
+            val session = assertNotNull(service.startSession(navigate = true, record = true))
+            idleWorker(service)
+            val file = assertNotNull(session.recordFile)
+            assertTrue(wakeLock()?.isHeld == true)
+            injectSecond(SystemClock.elapsedRealtimeNanos())
+            ShadowSystemClock.advanceBy(Duration.ofSeconds(3))
+            service.workLooper?.let { l -> android.os.Handler(l).post { session.pump() } }
+            idleWorker(service)
+            idleWorker(service)
+            assertTrue(calls >= 1, "the sink was called")
+            val why = assertNotNull(service.lastError, "error reported for $failure")
+            assertTrue(why.contains(if (failure is IOException) "No space left" else "native library"), why)
+            assertEquals(listOf(why), errors, "listener told once")
+            assertNull(service.session, "session ended")
+            assertFalse(wakeLock()?.isHeld == true, "wake lock released on error")
+            val nm = app.getSystemService(NotificationManager::class.java)
+            assertTrue(shadowOf(nm).allNotifications.any { n -> n.extras.getCharSequence("android.text")?.contains(why) == true },
+                "error notification posted")
+            assertTrue(file.isFile, "recording kept")
+            val meta = readAll(file).filter { it.first == SampleKind.META }.map { it.third.string(0, 0) to it.third.string(0, 1) }
+            assertTrue(meta.any { it.first == NavigationSession.KEY_END && it.second.startsWith("error") }, "end marker says error: $meta")
+            controller.destroy()
+        }
+    }
+
+    @Test
+    fun wakeLockIsReleasedInOnDestroyAndTheNotificationHasAStopAction() {
+        val controller = Robolectric.buildService(NavigationService::class.java).create()
+        val service = controller.get()
+        assertNotNull(service.startSession(navigate = false, record = true))
+        idleWorker(service)
+        assertTrue(wakeLock()?.isHeld == true)
+        val n = assertNotNull(shadowOf(service).lastForegroundNotification)
+        val stop = assertNotNull(n.actions?.firstOrNull { it.title.toString() == app.getString(org.pdnav.app.R.string.action_stop) }, "Stop action")
+        val saved = shadowOf(stop.actionIntent).savedIntent
+        assertEquals(NavigationService.ACTION_STOP, saved.action)
+        assertTrue(shadowOf(stop.actionIntent).isService)
+        assertEquals(Service.START_STICKY, service.onStartCommand(null, 0, 1), "a killed session is restarted and found")
+        controller.destroy()
+        assertFalse(wakeLock()?.isHeld == true, "wake lock released in onDestroy")
+    }
+
+    @Test
+    fun aDeclaredStartBelongsToOneSessionIsRecordedAndTheReplayReproducesIt() {
+        val service = Robolectric.buildService(NavigationService::class.java).create().get()
+        // session 1: a start declared before it (header) and one mid-walk, and a checkpoint
+        val s1 = assertNotNull(service.startSession(navigate = true, record = true, declaredStart = doubleArrayOf(42.5, 1.5, 5.0)))
+        idleWorker(service)
+        val t0 = SystemClock.elapsedRealtimeNanos()
+        injectSecond(t0)
+        ShadowSystemClock.advanceBy(Duration.ofSeconds(2))
+        idleWorker(service)
+        assertTrue(service.declareStart(42.501, 1.501, 3.0))
+        assertTrue(service.checkpoint(42.5011, 1.5011))
+        idleWorker(service)
+        injectSecond(SystemClock.elapsedRealtimeNanos())
+        ShadowSystemClock.advanceBy(Duration.ofSeconds(3))
+        s1.pump()
+        s1.merger.flush(SystemClock.elapsedRealtimeNanos(), all = true)  // everything the file will hold
+        val live = assertNotNull(s1.navigator).estimate()
+        assertEquals(1, assertNotNull(s1.feeder).startsApplied, "mid-walk start applied live")
+        val f1 = assertNotNull(s1.recordFile)
+        stopAndJoin(service)
+
+        val meta1 = readAll(f1).filter { it.first == SampleKind.META }.map { it.third.string(0, 0) to it.third.string(0, 1) }
+        assertEquals(listOf("42.5", "42.501"), meta1.filter { it.first == "StartLatitudeDegrees" }.map { it.second }, "both starts in the log")
+        assertTrue(readAll(f1).any { it.first == SampleKind.TRUTH }, "checkpoint written as a Truth line")
+
+        // the replay applies the recorded mid-walk start at its time: same estimate as live
+        var replayed: NavOutput? = null
+        val task = ReplayTask(f1.path, org.pdnav.app.ui.AppSettings(app.getSharedPreferences(org.pdnav.app.ui.AppSettings.PREFS, 0)).navigatorConfig(),
+            1L, onProgress = { _, _ -> }, onDone = { o, _ -> replayed = o })
+        task.run()
+        val r = assertNotNull(replayed).estimate
+        assertTrue(live.latDeg.isFinite(), "live estimate has a position")
+        assertEquals(live.latDeg, r.latDeg, 1e-9, "replay reproduces the live estimate (lat)")
+        assertEquals(live.lonDeg, r.lonDeg, 1e-9, "replay reproduces the live estimate (lon)")
+        assertTrue(Math.abs(r.latDeg - 42.501) < 1e-3, "replay restarted at the mid-walk start: ${r.latDeg}")
+        assertEquals(1, task.checkpoints.size, "checkpoint scored in replay")
+        val c = task.checkpoints[0]
+        assertTrue(c.errorM.isFinite() && c.errorM < 50.0, "checkpoint error ${c.errorM} m")
+        NativeLogReader(f1.path).use { } // file still readable
+
+        // session 2 without a declared start: nothing carried over, neither in config nor log
+        assertTrue(service.startSession(navigate = true, record = true) != null)
+        idleWorker(service)
+        val s2 = assertNotNull(service.session)
+        val f2 = assertNotNull(s2.recordFile)
+        stopAndJoin(service)
+        val meta2 = readAll(f2).filter { it.first == SampleKind.META }.map { it.third.string(0, 0) }
+        assertTrue("StartLatitudeDegrees" !in meta2, "session 2 must not inherit session 1's start: $meta2")
+        assertTrue(org.pdnav.app.ui.AppSettings(app.getSharedPreferences(org.pdnav.app.ui.AppSettings.PREFS, 0)).navigatorConfig().startLatDeg.isNaN())
+    }
+
+    @Test
+    fun aKilledSessionIsFoundMarkedAndOfferedForReplay() {
+        val store = SessionStore(app)
+        val f = store.newSessionFile(1_700_000_000_000L)
+        f.writeText("# pdnav-log\nMeta,5000000000,Device,test\nAccel,,6000000000,0.1,0.2,9.8\nAccel,,7000000000,0.1,0.2,9")  // torn
+        store.markActive(f)
+        val service = Robolectric.buildService(NavigationService::class.java).create().get()
+        assertEquals(f, service.interrupted)
+        val meta = NativeLogReader(f.path).use { r ->
+            val b = SampleBatch()
+            val out = mutableListOf<Pair<String, String>>()
+            while (r.read(b, 100)) for (i in 0 until b.size) if (b.kind(i) == SampleKind.META) out += b.string(i, 0) to b.string(i, 1)
+            out
+        }
+        assertTrue(NavigationSession.KEY_END to "interrupted" in meta, "end marker appended: $meta")
+        assertNull(SessionStore(app).recoverInterrupted(), "found once")
     }
 }

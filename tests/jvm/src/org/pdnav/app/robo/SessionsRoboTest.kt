@@ -47,6 +47,7 @@ class SessionsRoboTest {
         assertEquals(Intent.ACTION_CHOOSER, chooser.action)
         @Suppress("DEPRECATION") val send = assertNotNull(chooser.getParcelableExtra<Intent>(Intent.EXTRA_INTENT))
         assertEquals(Intent.ACTION_SEND, send.action)
+        assertEquals("text/csv", send.type, "a log is data, not text to paste")
         @Suppress("DEPRECATION") val uri = assertNotNull(send.getParcelableExtra<Uri>(Intent.EXTRA_STREAM))
         assertEquals(SessionProvider.AUTHORITY, uri.authority)
         assertTrue(send.flags and Intent.FLAG_GRANT_READ_URI_PERMISSION != 0, "read permission granted to the receiver")
@@ -63,6 +64,39 @@ class SessionsRoboTest {
         val replay = assertNotNull(shadowOf(activity).nextStartedActivity)
         assertEquals(MainActivity::class.java.name, replay.component?.className)
         assertEquals(older.path, replay.getStringExtra(MainActivity.EXTRA_REPLAY))
+    }
+
+    @Test
+    fun noSessionsShowsTheAttachedEmptyViewAndDeleteZipExportWork() {
+        SessionStore(app).list().forEach { it.delete() }
+        val controller = Robolectric.buildActivity(SessionsActivity::class.java).setup()
+        val activity = controller.get()
+        val list = activity.findViewById<ListView>(R.id.sessions_list)
+        val empty = assertNotNull(activity.findViewById<android.widget.TextView>(R.id.sessions_empty), "empty view in the hierarchy")
+        assertEquals(empty, list.emptyView)
+        assertEquals(android.view.View.VISIBLE, empty.visibility, "empty view shown")
+
+        val store = SessionStore(app)
+        val f = store.newSessionFile(1_700_000_200_000L).apply { writeText("Meta,1,Device,x\n") }
+        controller.pause().resume()
+        assertEquals(1, list.adapter.count)
+        assertEquals(android.view.View.GONE, empty.visibility)
+
+        activity.shareZip(f)
+        val chooser = assertNotNull(shadowOf(activity).nextStartedActivity)
+        @Suppress("DEPRECATION") val send = assertNotNull(chooser.getParcelableExtra<Intent>(Intent.EXTRA_INTENT))
+        assertEquals("application/zip", send.type)
+        val zip = java.io.File(store.dir, f.name.removeSuffix(".txt") + ".zip")
+        java.util.zip.ZipFile(zip).use { z -> assertEquals(f.readText(), z.getInputStream(z.getEntry(f.name)).readBytes().decodeToString()) }
+
+        activity.export(f)
+        val create = assertNotNull(shadowOf(activity).nextStartedActivity)
+        assertEquals(Intent.ACTION_CREATE_DOCUMENT, create.action)
+        assertEquals(f.name, create.getStringExtra(Intent.EXTRA_TITLE))
+
+        activity.delete(f, confirm = false)
+        assertTrue(!f.exists())
+        assertEquals(0, list.adapter.count)
     }
 
     @Test

@@ -62,4 +62,9 @@ object NativeBridge {
     @JvmStatic external fun readerStats(handle: Long): LongArray
     @JvmStatic external fun readerProgress(handle: Long): Double
     @JvmStatic external fun readerClose(handle: Long)
+
+    /** Walkway graph edges as WGS84 polylines: lat, lon pairs, each edge ended by NaN, NaN. */
+    @JvmStatic external fun graphPolylines(path: String?): DoubleArray
+    /** DEM tile bounds: min lat, min lon, max lat, max lon (degrees). */
+    @JvmStatic external fun demBounds(path: String?): DoubleArray
 }

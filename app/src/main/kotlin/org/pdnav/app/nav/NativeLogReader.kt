@@ -5,37 +5,37 @@ package org.pdnav.app.nav
  * [SampleBatch]es, in file order, for replay in the app and in the host tests.
  */
 class NativeLogReader(path: String) : AutoCloseable {
-    private val lock = Any()
-    private var handle: Long
+    private val h: NativeHandle
+    private val registration: NativeCleaner.Registration
 
     init {
         NativeBridge.ensureLoaded()
-        handle = NativeBridge.readerOpen(path)
+        h = NativeHandle(NativeBridge.readerOpen(path)) { NativeBridge.readerClose(it) }
+        registration = NativeCleaner.register(this, h)
     }
 
     /** Replaces the content of [into] with up to [max] next samples; false at end of input. */
-    fun read(into: SampleBatch, max: Int = 512): Boolean = synchronized(lock) {
+    fun read(into: SampleBatch, max: Int = 512): Boolean = synchronized(h) {
         into.clear()
         into.ensureCapacity(max)
-        val n = NativeBridge.readerRead(handle, max, into.kinds, into.tNs, into.ints, into.doubles, into.strings, into.bytes)
+        val n = NativeBridge.readerRead(h.get(), max, into.kinds, into.tNs, into.ints, into.doubles, into.strings, into.bytes)
         into.setFilled(n)
         n > 0
     }
 
     /** Fraction of the file consumed, 0..1. */
-    val progress: Double get() = synchronized(lock) { NativeBridge.readerProgress(handle) }
+    val progress: Double get() = synchronized(h) { NativeBridge.readerProgress(h.get()) }
 
     /** Lines read, samples returned and lines skipped so far. */
     val stats: ReadStats
-        get() = synchronized(lock) {
-            val s = NativeBridge.readerStats(handle)
+        get() = synchronized(h) {
+            val s = NativeBridge.readerStats(h.get())
             ReadStats(s[0], s[1], s[2])
         }
 
-    override fun close() = synchronized(lock) {
-        val h = handle
-        handle = 0L
-        if (h != 0L) NativeBridge.readerClose(h)
+    override fun close() {
+        registration.unregister()
+        h.close()
     }
 }
 

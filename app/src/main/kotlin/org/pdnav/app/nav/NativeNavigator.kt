@@ -2,55 +2,57 @@ package org.pdnav.app.nav
 
 /**
  * fusion::Navigator behind an opaque native handle: the one navigation API of the app and
- * of the host tests. Calls are serialised on this object; [close] is idempotent; any call
- * after close throws IllegalStateException (from the bridge, which sees handle 0).
+ * of the host tests. Calls are serialised on the handle; [close] is idempotent; any call
+ * after close throws IllegalStateException (from the bridge, which sees handle 0). A
+ * navigator dropped without close() is released by [NativeCleaner].
  */
 class NativeNavigator(config: NavigatorConfig, seed: Long) : AutoCloseable, SampleSink {
-    private val lock = Any()
-    private var handle: Long
+    private val h: NativeHandle
+    private val registration: NativeCleaner.Registration
 
     init {
         NativeBridge.ensureLoaded()
-        handle = NativeBridge.navCreate(
+        val raw = NativeBridge.navCreate(
             config.mode, config.startLatDeg, config.startLonDeg, config.startSigmaM,
             config.userHeightM, config.userFemale, config.demPath, config.graphPath,
             config.navPaths.toTypedArray(), config.particles, config.terrainPreset, seed,
         )
+        h = NativeHandle(raw) { NativeBridge.navClose(it) }
+        registration = NativeCleaner.register(this, h)
     }
 
-    val isClosed: Boolean get() = synchronized(lock) { handle == 0L }
+    val isClosed: Boolean get() = h.isClosed
 
     /** Feeds every row of [batch] in row order (the caller keeps rows in time order). */
-    fun feed(batch: SampleBatch) = synchronized(lock) {
-        NativeBridge.navFeed(handle, batch.size, batch.kinds, batch.tNs, batch.ints, batch.doubles, batch.strings, batch.bytes)
+    fun feed(batch: SampleBatch) = synchronized(h) {
+        NativeBridge.navFeed(h.get(), batch.size, batch.kinds, batch.tNs, batch.ints, batch.doubles, batch.strings, batch.bytes)
     }
 
     override fun write(batch: SampleBatch) = feed(batch)
 
-    fun setStart(latDeg: Double, lonDeg: Double, sigmaM: Double, tNs: Long) = synchronized(lock) {
-        NativeBridge.navSetStart(handle, latDeg, lonDeg, sigmaM, tNs)
+    fun setStart(latDeg: Double, lonDeg: Double, sigmaM: Double, tNs: Long) = synchronized(h) {
+        NativeBridge.navSetStart(h.get(), latDeg, lonDeg, sigmaM, tNs)
     }
 
-    fun estimate(): NavEstimate = synchronized(lock) { NativeBridge.navEstimate(handle) }
+    fun estimate(): NavEstimate = synchronized(h) { NativeBridge.navEstimate(h.get()) }
 
-    fun output(maxParticles: Int = 200): NavOutput = synchronized(lock) { NativeBridge.navOutput(handle, maxParticles) }
+    fun output(maxParticles: Int = 200): NavOutput = synchronized(h) { NativeBridge.navOutput(h.get(), maxParticles) }
 
     /** Samples the core ignored, by reason. */
-    fun ignored(): Map<String, Long> = synchronized(lock) {
-        val flat = NativeBridge.navIgnored(handle)
+    fun ignored(): Map<String, Long> = synchronized(h) {
+        val flat = NativeBridge.navIgnored(h.get())
         (flat.indices step 2).associate { flat[it] to flat[it + 1].toLong() }
     }
 
     /** Hand-overs of the fused estimate ("gnss", "gnss-degraded", "route", "terrain", "pdr"), with reasons. */
-    fun modeChanges(): List<ModeChange> = synchronized(lock) {
-        val flat = NativeBridge.navModeChanges(handle)
+    fun modeChanges(): List<ModeChange> = synchronized(h) {
+        val flat = NativeBridge.navModeChanges(h.get())
         (flat.indices step 4).map { ModeChange(flat[it].toLong(), flat[it + 1], flat[it + 2], flat[it + 3]) }
     }
 
-    override fun close() = synchronized(lock) {
-        val h = handle
-        handle = 0L
-        if (h != 0L) NativeBridge.navClose(h)
+    override fun close() {
+        registration.unregister()
+        h.close()
     }
 }
 

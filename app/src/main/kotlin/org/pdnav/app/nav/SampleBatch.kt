@@ -158,6 +158,31 @@ class SampleBatch(initialCapacity: Int = 256) {
         data.copyInto(bytes, r * BYTES)
     }
 
+    /** One satellite of a GnssStatus callback (GnssLogger `Status` line). */
+    fun addStatus(t: Long, utcMs: Long, count: Int, index: Int, constellation: Int, svid: Int, used: Boolean,
+                  almanac: Boolean, ephemeris: Boolean, carrierHz: Double, cn0DbHz: Double, azimuthDeg: Double,
+                  elevationDeg: Double, basebandCn0DbHz: Double) {
+        val r = addRow(SampleKind.GNSS_STATUS, t)
+        setLong(r, 0, utcMs); setLong(r, 1, count.toLong()); setLong(r, 2, index.toLong())
+        setLong(r, 3, constellation.toLong()); setLong(r, 4, svid.toLong())
+        setLong(r, 5, if (used) 1 else 0); setLong(r, 6, if (almanac) 1 else 0); setLong(r, 7, if (ephemeris) 1 else 0)
+        setDouble(r, 0, carrierHz); setDouble(r, 1, cn0DbHz); setDouble(r, 2, azimuthDeg); setDouble(r, 3, elevationDeg)
+        setDouble(r, 4, basebandCn0DbHz)
+    }
+
+    /** Automatic gain control of one band (GnssLogger `Agc` line, API 33+). */
+    fun addAgc(t: Long, utcMs: Long, timeNanos: Long, constellation: Int, agcDb: Double, carrierHz: Double) {
+        val r = addRow(SampleKind.AGC, t)
+        setLong(r, 0, utcMs); setLong(r, 1, timeNanos); setLong(r, 2, constellation.toLong())
+        setDouble(r, 0, agcDb); setDouble(r, 1, carrierHz)
+    }
+
+    /** A known position (checkpoint) at time t: the `Truth` line replay scores against. */
+    fun addTruth(t: Long, latDeg: Double, lonDeg: Double, heightM: Double = Double.NaN, headingDeg: Double = Double.NaN) {
+        val r = addRow(SampleKind.TRUTH, t)
+        setDouble(r, 0, latDeg); setDouble(r, 1, lonDeg); setDouble(r, 2, heightM); setDouble(r, 3, headingDeg)
+    }
+
     fun addMeta(t: Long, key: String, value: String) {
         val r = addRow(SampleKind.META, t)
         setString(r, 0, key)

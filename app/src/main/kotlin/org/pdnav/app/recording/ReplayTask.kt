@@ -5,11 +5,15 @@ import org.pdnav.app.nav.NativeNavigator
 import org.pdnav.app.nav.NavOutput
 import org.pdnav.app.nav.NavigatorConfig
 import org.pdnav.app.nav.SampleBatch
+import org.pdnav.app.nav.SessionFeeder
 
 /**
- * Replays a recorded session through a fresh navigator on a background thread (the in-app
- * replay). [onProgress] gets the output and the fraction read about every [everyNs] of log
- * time; [onDone] gets the final output, or the error that stopped it.
+ * Replays a recorded session through a fresh navigator on a background thread (owned by
+ * NavigationService, so it survives the Activity). Rows go to the native side in batches
+ * of [CHUNK] (one JNI call each, not one per row) through a [SessionFeeder], which applies
+ * the declared starts the session recorded and scores its `Truth` checkpoints ([checkpoints]).
+ * [onProgress] gets the output and the fraction read about every [everyNs] of log time
+ * (at batch ends); [onDone] the final output, or the error that stopped it.
  */
 class ReplayTask(
     private val path: String,
@@ -21,6 +25,14 @@ class ReplayTask(
 ) {
     @Volatile private var cancelled = false
     private var thread: Thread? = null
+
+    /** Checkpoints scored (after the replay, or so far). */
+    @Volatile var checkpoints: List<SessionFeeder.Checkpoint> = emptyList()
+        private set
+
+    /** JNI calls that fed rows (the batching check). */
+    @Volatile var feedCalls = 0L
+        private set
 
     fun start() {
         thread = Thread({ run() }, "pdnav-replay").apply { start() }
@@ -40,27 +52,24 @@ class ReplayTask(
         try {
             var last: NavOutput? = null
             NativeNavigator(config, seed).use { nav ->
+                val feeder = SessionFeeder(nav)
                 NativeLogReader(path).use { reader ->
                     val batch = SampleBatch(CHUNK)
-                    val one = SampleBatch(1)
                     var nextReportNs = Long.MIN_VALUE
                     while (!cancelled && reader.read(batch, CHUNK)) {
-                        // row by row so progress reports fall on the log's own time grid
-                        for (i in 0 until batch.size) {
-                            one.clear()
-                            one.addCopy(batch, i)
-                            nav.feed(one)
-                            val t = batch.tNs(i)
-                            if (nextReportNs == Long.MIN_VALUE) nextReportNs = t + everyNs
-                            if (t >= nextReportNs) {
-                                nextReportNs = t + everyNs
-                                val out = nav.output(200)
-                                last = out
-                                onProgress(out, reader.progress)
-                            }
+                        feeder.write(batch)
+                        feedCalls = feeder.feedCalls
+                        val t = batch.tNs(batch.size - 1)
+                        if (nextReportNs == Long.MIN_VALUE) nextReportNs = batch.tNs(0) + everyNs
+                        if (t >= nextReportNs) {
+                            nextReportNs = t + everyNs
+                            val out = nav.output(200)
+                            last = out
+                            onProgress(out, reader.progress)
                         }
                     }
                 }
+                checkpoints = feeder.checkpoints
                 last = nav.output(200)
             }
             onDone(last, null)
@@ -70,6 +79,6 @@ class ReplayTask(
     }
 
     companion object {
-        private const val CHUNK = 512
+        const val CHUNK = 512
     }
 }

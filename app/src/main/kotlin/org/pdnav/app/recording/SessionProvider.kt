@@ -23,7 +23,9 @@ class SessionProvider : ContentProvider() {
         val name = uri.lastPathSegment ?: throw FileNotFoundException("no file name in $uri")
         if (name.contains('/') || name.startsWith(".")) throw FileNotFoundException("bad session name $name")
         val f = File(SessionStore(ctx).dir, name)
-        if (!f.isFile) throw FileNotFoundException("no session $name")
+        if (!f.isFile || !(name.endsWith(SessionStore.SUFFIX) || name.endsWith(SessionStore.ZIP_SUFFIX))) {
+            throw FileNotFoundException("no session $name")
+        }
         return f
     }
 
@@ -38,12 +40,18 @@ class SessionProvider : ContentProvider() {
         return MatrixCursor(cols, 1).apply { addRow(arrayOf<Any>(f.name, f.length())) }
     }
 
-    override fun getType(uri: Uri) = "text/plain"
+    override fun getType(uri: Uri): String = mimeType(uri.lastPathSegment ?: "")
     override fun insert(uri: Uri, values: ContentValues?): Uri? = null
     override fun delete(uri: Uri, selection: String?, selectionArgs: Array<out String>?) = 0
     override fun update(uri: Uri, values: ContentValues?, selection: String?, selectionArgs: Array<out String>?) = 0
 
     companion object {
         const val AUTHORITY = "org.pdnav.app.sessions"
+
+        /**
+         * A session log is a CSV-like data file, not text to paste into a message
+         * (text/plain makes chat apps inline it): text/csv; a zip is application/zip.
+         */
+        fun mimeType(name: String): String = if (name.endsWith(SessionStore.ZIP_SUFFIX)) "application/zip" else "text/csv"
     }
 }

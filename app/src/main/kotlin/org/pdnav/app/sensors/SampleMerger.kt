@@ -1,21 +1,24 @@
 package org.pdnav.app.sensors
 
 import org.pdnav.app.nav.SampleBatch
+import org.pdnav.app.nav.SampleKind
 import org.pdnav.app.nav.SampleSink
 
 /**
  * Merges the sample streams of all sensors (each in time order, delivered late and in
  * batches) into one time-ordered stream for the sinks (navigator, recorder).
  *
- * Sensor callbacks [add] rows; [flush] (called periodically on one thread) hands every row
- * older than `now - holdNs` to the sinks in time order. [holdNs] must cover the sensors'
- * batching latency and the GNSS callback delay, so rows are almost never late; a row that
- * is late anyway (older than what was already emitted) is still emitted, in the next flush,
- * and counted in [lateRows] (each sensor's own order is always kept).
+ * Sensor callbacks [add] rows; [flush] (called from one thread) hands every row older than
+ * `now - holdNs` to the sinks in time order. [holdNs] must cover the sensors' batching
+ * latency and the GNSS callback delay, so rows are almost never late; a row that is late
+ * anyway (older than what was already emitted) is still emitted, in the next flush, counted
+ * in [lateRows] and reported to [onLate] (kind, its time, how far behind) so the session
+ * can log and show it. Sinks may be added and removed while running ([setSinks]).
  */
 class SampleMerger(
     private val holdNs: Long,
-    private val sinks: List<SampleSink>,
+    sinks: List<SampleSink>,
+    private val onLate: (kind: Int, tNs: Long, behindNs: Long) -> Unit = { _, _, _ -> },
 ) {
     private val pendingLock = Any()
     private var pending = SampleBatch(512)
@@ -23,6 +26,8 @@ class SampleMerger(
     private val out = SampleBatch(512)
     private val flushLock = Any()
     private var lastEmittedNs = Long.MIN_VALUE
+    @Volatile private var sinks: List<SampleSink> = sinks.toList()
+    private val byKind = LongArray(SampleKind.COUNT)
 
     /** Rows emitted after a later row had already been emitted. */
     @Volatile var lateRows = 0L
@@ -32,12 +37,22 @@ class SampleMerger(
     @Volatile var emittedRows = 0L
         private set
 
+    /** Rows emitted so far, per sample kind (index = SampleKind). */
+    fun emittedByKind(): LongArray = synchronized(flushLock) { byKind.copyOf() }
+
+    /** Replaces the sinks (taking effect at the next flush). */
+    fun setSinks(s: List<SampleSink>) = synchronized(flushLock) { sinks = s.toList() }
+
     /** Adds rows from a sensor callback (any thread). */
     fun add(fill: (SampleBatch) -> Unit) {
         synchronized(pendingLock) { fill(pending) }
     }
 
-    /** Emits the rows older than nowNs - holdNs (all rows when [all]), in time order. */
+    /**
+     * Emits the rows older than nowNs - holdNs (all rows when [all]), in time order. A sink
+     * that throws stops the flush (the exception reaches the caller; rows already taken out
+     * of the queue are not re-queued: the session ends on such an error).
+     */
     fun flush(nowNs: Long, all: Boolean = false) = synchronized(flushLock) {
         out.clear()
         synchronized(pendingLock) {
@@ -52,7 +67,14 @@ class SampleMerger(
         }
         if (out.size == 0) return@synchronized
         for (i in 0 until out.size) {
-            if (out.tNs(i) < lastEmittedNs) lateRows++ else lastEmittedNs = out.tNs(i)
+            val t = out.tNs(i)
+            if (t < lastEmittedNs) {
+                lateRows++
+                onLate(out.kind(i), t, lastEmittedNs - t)
+            } else {
+                lastEmittedNs = t
+            }
+            byKind[out.kind(i)]++
         }
         emittedRows += out.size
         for (sink in sinks) sink.write(out)

@@ -4,6 +4,7 @@ import android.hardware.Sensor
 import android.hardware.SensorEvent
 import android.hardware.SensorEventListener
 import android.hardware.SensorManager
+import android.os.Build
 import android.os.Handler
 import org.pdnav.app.nav.SampleBatch
 import org.pdnav.app.nav.SampleKind
@@ -13,25 +14,60 @@ import kotlin.math.sqrt
  * The phone's motion and pressure sensors, registered with explicit rates and hardware
  * batching, converted into [SampleBatch] rows on the merger. SensorEvent.timestamp is on the
  * elapsedRealtimeNanos clock on Android 7+ phones (the project's common timeline).
+ *
+ * Screen off: the session holds a partial wake lock, so the CPU keeps draining the sensor
+ * FIFOs; where the phone has a wake-up variant of a sensor it is preferred (its FIFO wakes
+ * the CPU before it overflows, so batching survives even a suspend the wake lock did not
+ * prevent). [onEvent] runs after every delivery: the session pumps from there.
  */
-class SensorSource(private val sensors: SensorManager, private val merger: SampleMerger) : SensorEventListener {
+class SensorSource(
+    private val sensors: SensorManager,
+    private val merger: SampleMerger,
+    private val onEvent: () -> Unit = {},
+) : SensorEventListener {
 
-    /** One sensor subscription: type, sampling period and allowed report latency. */
-    data class Rate(val type: Int, val periodUs: Int, val maxLatencyUs: Int)
+    /** One sensor subscription: type, sampling period and allowed report latency, minimum API. */
+    data class Rate(val type: Int, val periodUs: Int, val maxLatencyUs: Int, val minSdk: Int = 24)
 
     private val registered = mutableListOf<Sensor>()
+    private val rows = java.util.concurrent.ConcurrentHashMap<Int, Long>()
+
+    /** Magnetometer accuracy (SensorManager.SENSOR_STATUS_*), -1 before the first report. */
+    @Volatile var magAccuracy = -1
+        private set
+
+    /** Sensors registered as wake-up sensors. */
+    var wakeUpTypes: List<Int> = emptyList()
+        private set
+
+    /** Rows delivered so far per sensor type. */
+    fun rowsByType(): Map<Int, Long> = HashMap(rows)
 
     /** Registers every available sensor of [RATES]; returns the types registered. */
     fun start(handler: Handler?): List<Int> {
         val types = mutableListOf<Int>()
+        val wake = mutableListOf<Int>()
         for (r in RATES) {
-            val s = sensors.getDefaultSensor(r.type) ?: continue
+            if (Build.VERSION.SDK_INT < r.minSdk) continue
+            val s = defaultSensor(r.type) ?: continue
             if (sensors.registerListener(this, s, r.periodUs, r.maxLatencyUs, handler)) {
                 registered += s
                 types += r.type
+                if (s.isWakeUpSensor) wake += r.type
             }
         }
+        wakeUpTypes = wake
         return types
+    }
+
+    /** The wake-up variant when the phone has one, else the default sensor of [type]. */
+    private fun defaultSensor(type: Int): Sensor? {
+        val wakeUp = try {
+            sensors.getDefaultSensor(type, true)
+        } catch (e: RuntimeException) {
+            null  // some vendor/emulator images do not list wake-up sensors
+        }
+        return wakeUp ?: sensors.getDefaultSensor(type)
     }
 
     fun stop() {
@@ -42,10 +78,16 @@ class SensorSource(private val sensors: SensorManager, private val merger: Sampl
     override fun onSensorChanged(event: SensorEvent) {
         val t = event.timestamp
         val v = event.values
-        merger.add { b -> addEvent(b, event.sensor.type, t, v) }
+        val type = event.sensor.type
+        if (type == Sensor.TYPE_MAGNETIC_FIELD) magAccuracy = event.accuracy
+        merger.add { b -> addEvent(b, type, t, v) }
+        rows.merge(type, 1L, Long::plus)
+        onEvent()
     }
 
-    override fun onAccuracyChanged(sensor: Sensor, accuracy: Int) = Unit
+    override fun onAccuracyChanged(sensor: Sensor, accuracy: Int) {
+        if (sensor.type == Sensor.TYPE_MAGNETIC_FIELD) magAccuracy = accuracy
+    }
 
     companion object {
         /** Batching: up to 100 ms of samples per delivery (saves power, keeps latency low). */
@@ -59,7 +101,25 @@ class SensorSource(private val sensors: SensorManager, private val merger: Sampl
             Rate(Sensor.TYPE_ROTATION_VECTOR, 20_000, LATENCY_US),
             Rate(Sensor.TYPE_PRESSURE, 100_000, LATENCY_US),
             Rate(Sensor.TYPE_STEP_DETECTOR, 0, 0),
+            // GnssLogger's UncalAccel / UncalGyro / UncalMag (bias estimates kept beside the values)
+            Rate(Sensor.TYPE_ACCELEROMETER_UNCALIBRATED, 10_000, LATENCY_US, minSdk = 26),
+            Rate(Sensor.TYPE_GYROSCOPE_UNCALIBRATED, 10_000, LATENCY_US),
+            Rate(Sensor.TYPE_MAGNETIC_FIELD_UNCALIBRATED, 20_000, LATENCY_US),
         )
+
+        /** Human name of a sensor type, for the counters on screen. */
+        fun typeName(type: Int): String = when (type) {
+            Sensor.TYPE_ACCELEROMETER -> "accel"
+            Sensor.TYPE_GYROSCOPE -> "gyro"
+            Sensor.TYPE_MAGNETIC_FIELD -> "mag"
+            Sensor.TYPE_ROTATION_VECTOR -> "rotation"
+            Sensor.TYPE_PRESSURE -> "baro"
+            Sensor.TYPE_STEP_DETECTOR -> "steps"
+            Sensor.TYPE_ACCELEROMETER_UNCALIBRATED -> "uncal accel"
+            Sensor.TYPE_GYROSCOPE_UNCALIBRATED -> "uncal gyro"
+            Sensor.TYPE_MAGNETIC_FIELD_UNCALIBRATED -> "uncal mag"
+            else -> "type $type"
+        }
 
         /** Appends one SensorEvent (type, timestamp, values) as a row; other types are ignored. */
         fun addEvent(b: SampleBatch, type: Int, t: Long, v: FloatArray) {
@@ -70,7 +130,18 @@ class SensorSource(private val sensors: SensorManager, private val merger: Sampl
                 Sensor.TYPE_PRESSURE -> if (v.isNotEmpty()) b.addPressure(t, v[0] * 100.0)  // hPa -> Pa
                 Sensor.TYPE_ROTATION_VECTOR -> if (v.size >= 3) addRotation(b, t, v)
                 Sensor.TYPE_STEP_DETECTOR -> b.addStep(t)
+                Sensor.TYPE_ACCELEROMETER_UNCALIBRATED -> addUncal(b, SampleKind.UNCAL_ACCEL, t, v)
+                Sensor.TYPE_GYROSCOPE_UNCALIBRATED -> addUncal(b, SampleKind.UNCAL_GYRO, t, v)
+                Sensor.TYPE_MAGNETIC_FIELD_UNCALIBRATED -> addUncal(b, SampleKind.UNCAL_MAG, t, v)
             }
+        }
+
+        /** values[0..2] uncalibrated, values[3..5] the bias (drift for the gyroscope). */
+        private fun addUncal(b: SampleBatch, kind: Int, t: Long, v: FloatArray) {
+            if (v.size < 3) return
+            val value = DoubleArray(3) { v[it].toDouble() }
+            val bias = DoubleArray(3) { if (v.size >= 6) v[3 + it].toDouble() else Double.NaN }
+            b.addUncalibrated(kind, t, value, bias)
         }
 
         private fun addRotation(b: SampleBatch, t: Long, v: FloatArray) {

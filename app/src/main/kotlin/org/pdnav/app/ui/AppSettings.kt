@@ -21,13 +21,10 @@ class AppSettings(private val prefs: SharedPreferences) {
     var startSigmaM: Double
         get() = prefs.getFloat(KEY_SIGMA, 5f).toDouble()
         set(v) = prefs.edit().putFloat(KEY_SIGMA, v.toFloat()).apply()
-    /** Declared start (long-press on the map); NaN = use the first GNSS fix. */
-    var startLatDeg: Double
-        get() = java.lang.Double.longBitsToDouble(prefs.getLong(KEY_LAT, NAN_BITS))
-        set(v) = prefs.edit().putLong(KEY_LAT, java.lang.Double.doubleToRawLongBits(v)).apply()
-    var startLonDeg: Double
-        get() = java.lang.Double.longBitsToDouble(prefs.getLong(KEY_LON, NAN_BITS))
-        set(v) = prefs.edit().putLong(KEY_LON, java.lang.Double.doubleToRawLongBits(v)).apply()
+    /** GnssMeasurementRequest full tracking (API 31+): no duty cycling, more battery. */
+    var fullTracking: Boolean
+        get() = prefs.getBoolean(KEY_FULL_TRACKING, false)
+        set(v) = prefs.edit().putBoolean(KEY_FULL_TRACKING, v).apply()
     var demPath: String
         get() = prefs.getString(KEY_DEM, "") ?: ""
         set(v) = prefs.edit().putString(KEY_DEM, v).apply()
@@ -41,16 +38,13 @@ class AppSettings(private val prefs: SharedPreferences) {
         get() = prefs.getString(KEY_NAV, "") ?: ""
         set(v) = prefs.edit().putString(KEY_NAV, v).apply()
 
-    /** Start at the last GNSS fix instead of a declared point. */
-    fun useLastFix() {
-        startLatDeg = Double.NaN
-        startLonDeg = Double.NaN
-    }
-
+    /**
+     * The navigator's configuration. It never carries a start position: a declared start
+     * belongs to one session and travels in that session's stream (Meta lines, see
+     * SessionFeeder), so it is neither reused by later sessions nor forced onto a replay.
+     */
     fun navigatorConfig() = NavigatorConfig(
         mode = engine,
-        startLatDeg = startLatDeg,
-        startLonDeg = startLonDeg,
         startSigmaM = startSigmaM,
         userHeightM = heightM,
         userFemale = female,
@@ -60,17 +54,22 @@ class AppSettings(private val prefs: SharedPreferences) {
         particles = particles,
     )
 
+    init {
+        // Older versions kept the long-press start here and reused it for ever: drop it.
+        if (prefs.contains(OLD_KEY_LAT) || prefs.contains(OLD_KEY_LON)) prefs.edit().remove(OLD_KEY_LAT).remove(OLD_KEY_LON).apply()
+    }
+
     companion object {
         const val PREFS = "pdnav"
+        const val OLD_KEY_LAT = "start_lat_deg"
+        const val OLD_KEY_LON = "start_lon_deg"
         val ENGINES = listOf("auto", "dr", "terrain", "route", "gnss")
-        private val NAN_BITS = java.lang.Double.doubleToRawLongBits(Double.NaN)
         private const val KEY_HEIGHT = "height_m"
         private const val KEY_FEMALE = "female"
         private const val KEY_PARTICLES = "particles"
         private const val KEY_ENGINE = "engine"
         private const val KEY_SIGMA = "start_sigma_m"
-        private const val KEY_LAT = "start_lat_deg"
-        private const val KEY_LON = "start_lon_deg"
+        private const val KEY_FULL_TRACKING = "gnss_full_tracking"
         private const val KEY_DEM = "dem_path"
         private const val KEY_GRAPH = "graph_path"
         private const val KEY_BASEMAP = "basemap_path"

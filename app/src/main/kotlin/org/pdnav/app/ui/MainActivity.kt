@@ -2,54 +2,92 @@ package org.pdnav.app.ui
 
 import android.Manifest
 import android.app.Activity
+import android.app.AlertDialog
 import android.content.ComponentName
 import android.content.Context
 import android.content.Intent
 import android.content.ServiceConnection
 import android.content.pm.PackageManager
 import android.graphics.Color
+import android.location.LocationManager
 import android.net.Uri
 import android.os.Build
 import android.os.Bundle
-import android.os.Handler
 import android.os.IBinder
-import android.os.Looper
 import android.provider.Settings
+import android.text.InputType
 import android.view.Gravity
 import android.view.View
 import android.widget.Button
+import android.widget.EditText
 import android.widget.FrameLayout
 import android.widget.LinearLayout
 import android.widget.TextView
 import org.osmdroid.views.MapView
 import org.pdnav.app.R
 import org.pdnav.app.map.MapController
+import org.pdnav.app.map.MapData
 import org.pdnav.app.nav.NavOutput
-import org.pdnav.app.recording.ReplayTask
 import org.pdnav.app.sensors.NavigationService
+import org.pdnav.app.sensors.SessionStats
 import java.io.File
+import java.util.Locale
 
 /**
- * The map screen: offline basemap with the estimate, its error ellipse, the track and the
- * particle cloud; the engine and its status as text; Navigate / Record / Settings / Sessions.
- * Asks for fine location and activity recognition first and explains why when refused.
+ * The map screen: offline basemap with the estimate (arrow), its error ellipse, the track,
+ * each engine, the phone's own fix and the particle cloud; position, sigma and engine as
+ * numbers; the live state of the session (duration, file size, rows per line type, GNSS
+ * epochs, magnetometer accuracy); Navigate and Record as independent switches, Checkpoint,
+ * Follow, Satellites (sky plot), Settings, Sessions. Asks for location (required), physical
+ * activity and notifications (optional) and explains what a refusal costs.
  */
 class MainActivity : Activity() {
     private lateinit var settings: AppSettings
     private lateinit var mapController: MapController
     private lateinit var status: TextView
+    private lateinit var info: TextView
+    private lateinit var counters: TextView
     private lateinit var permissionPanel: LinearLayout
+    private lateinit var permissionText: TextView
+    private lateinit var locationPanel: LinearLayout
+    private lateinit var interruptedPanel: LinearLayout
+    private lateinit var interruptedText: TextView
     private lateinit var navigateButton: Button
     private lateinit var recordButton: Button
+    private lateinit var checkpointButton: Button
+    private lateinit var followButton: Button
+    private lateinit var skyPlot: SkyPlotView
     private var service: NavigationService? = null
-    private var replay: ReplayTask? = null
-    private val main = Handler(Looper.getMainLooper())
+    private var bound = false
+    private var asked = false
+    private var pendingReplay: String? = null
+    private var mapDataKey: String? = null
+
+    /** The background load of the graph / DEM bounds (tests join it). */
+    @Volatile var mapDataThread: Thread? = null
+        private set
+
+    /** The start declared by a long-press before Navigate: used by the next session only. */
+    var pendingStart: DoubleArray? = null
+        private set
 
     private val listener = object : NavigationService.Listener {
         override fun onOutput(output: NavOutput, track: List<DoubleArray>) = showOutput(output, track)
         override fun onError(message: String) {
-            status.text = message
+            status.text = getString(R.string.status_error, message)
             updateButtons()
+        }
+        override fun onState() = updateButtons()
+        override fun onStats(stats: SessionStats) = showStats(stats)
+        override fun onReplay(output: NavOutput?, fraction: Double, done: Boolean, error: String?) {
+            if (output != null) showOutput(output, emptyList())
+            val name = service?.replayPath?.let { File(it).name } ?: ""
+            status.text = when {
+                error != null -> getString(R.string.status_error, error)
+                done -> getString(R.string.status_replay_done, name) + (output?.let { " · " + it.estimate.statusText() } ?: "")
+                else -> getString(R.string.status_replaying, name, (fraction * 100).toInt())
+            }
+            if (done) updateButtons()
         }
     }
 
@@ -59,6 +97,13 @@ class MainActivity : Activity() {
             service = s
             s.addListener(listener)
             s.lastOutput?.let { showOutput(it, s.track) }
+            s.lastStats?.let { showStats(it) }
+            s.lastError?.let { status.text = getString(R.string.status_error, it) }
+            pendingReplay?.let {
+                pendingReplay = null
+                startReplay(it)
+            }
+            showInterrupted(s.interrupted)
             updateButtons()
         }
 
@@ -72,29 +117,38 @@ class MainActivity : Activity() {
         super.onCreate(savedInstanceState)
         settings = AppSettings(getSharedPreferences(AppSettings.PREFS, Context.MODE_PRIVATE))
         setContentView(buildLayout())
-        mapController.setOnLongPress { p ->
-            settings.startLatDeg = p.latitude
-            settings.startLonDeg = p.longitude
-            mapController.showStart(p)
-            service?.session?.setStart(p.latitude, p.longitude, settings.startSigmaM)
-            status.text = getString(R.string.status_start_set, p.latitude, p.longitude, settings.startSigmaM)
-        }
+        pendingStart = savedInstanceState?.getDoubleArray(STATE_START)
+        asked = savedInstanceState?.getBoolean(STATE_ASKED) ?: false
+        mapController.setOnLongPress { p -> declareStart(p.latitude, p.longitude) }
+        mapController.onFollowChanged = { updateFollow() }
         status.text = getString(R.string.status_idle)
-        ensurePermissions()
-        handleReplayIntent(intent)
+        if (savedInstanceState?.getBoolean(STATE_ASKED) != true) ensurePermissions()
+        pendingReplay = intent?.getStringExtra(EXTRA_REPLAY)
+        if (savedInstanceState != null) pendingReplay = null  // a rotation: the service already replays it
+    }
+
+    override fun onSaveInstanceState(outState: Bundle) {
+        super.onSaveInstanceState(outState)
+        pendingStart?.let { outState.putDoubleArray(STATE_START, it) }
+        outState.putBoolean(STATE_ASKED, asked)
     }
 
     override fun onStart() {
         super.onStart()
-        if (!mapController.loadBasemap(this, settings.basemapPath.takeIf { it.isNotEmpty() }?.let(::File))) {
+        val basemap = settings.basemapPath.takeIf { it.isNotEmpty() }?.let(::File)
+        val hasBasemap = mapController.loadBasemap(this, basemap)
+        if (!hasBasemap) {
             status.text = getString(R.string.status_no_basemap)
+            centerOnLastFix()
         }
-        bindService(Intent(this, NavigationService::class.java), connection, Context.BIND_AUTO_CREATE)
+        loadMapData(centerOnDem = !hasBasemap)
+        bound = bindService(Intent(this, NavigationService::class.java), connection, Context.BIND_AUTO_CREATE)
     }
 
     override fun onStop() {
         service?.removeListener(listener)
-        unbindService(connection)
+        if (bound) unbindService(connection)
+        bound = false
         service = null
         super.onStop()
     }
@@ -102,6 +156,10 @@ class MainActivity : Activity() {
     override fun onResume() {
         super.onResume()
         mapController.map.onResume()
+        // the user may have granted in the system settings meanwhile: check again
+        if (asked) showExplanation(missingPermissions().isNotEmpty())
+        updateLocationPrompt(null)
+        updateButtons()
     }
 
     override fun onPause() {
@@ -109,40 +167,41 @@ class MainActivity : Activity() {
         super.onPause()
     }
 
-    override fun onDestroy() {
-        replay?.cancel()
-        super.onDestroy()
-    }
-
     override fun onNewIntent(intent: Intent) {
         super.onNewIntent(intent)
-        handleReplayIntent(intent)
+        intent.getStringExtra(EXTRA_REPLAY)?.let { startReplay(it) }
     }
 
     // ---- permissions ------------------------------------------------------------------------
 
-    /** Permissions without which the app can neither navigate nor record. */
-    fun requiredPermissions(): List<String> {
-        val p = mutableListOf(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACCESS_COARSE_LOCATION)
+    /** Permissions without which the app can neither navigate nor record (GNSS + fixes). */
+    fun requiredPermissions(): List<String> =
+        listOf(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACCESS_COARSE_LOCATION)
+
+    /** Asked too, but optional: step detector (29+) and the notification (33+). */
+    fun optionalPermissions(): List<String> {
+        val p = mutableListOf<String>()
         if (Build.VERSION.SDK_INT >= 29) p += Manifest.permission.ACTIVITY_RECOGNITION
+        if (Build.VERSION.SDK_INT >= 33) p += Manifest.permission.POST_NOTIFICATIONS
         return p
     }
 
-    private fun missingPermissions() = requiredPermissions().filter { checkSelfPermission(it) != PackageManager.PERMISSION_GRANTED }
+    private fun granted(p: String) = checkSelfPermission(p) == PackageManager.PERMISSION_GRANTED
+    private fun missingPermissions() = requiredPermissions().filter { !granted(it) }
 
     private fun ensurePermissions() {
-        val missing = missingPermissions().toMutableList()
-        if (missing.isEmpty()) {
+        val ask = (requiredPermissions() + optionalPermissions()).filter { !granted(it) }
+        if (ask.isEmpty()) {
             showExplanation(false)
             return
         }
-        if (Build.VERSION.SDK_INT >= 33) missing += Manifest.permission.POST_NOTIFICATIONS
-        requestPermissions(missing.toTypedArray(), REQUEST_PERMISSIONS)
+        requestPermissions(ask.toTypedArray(), REQUEST_PERMISSIONS)
     }
 
     override fun onRequestPermissionsResult(requestCode: Int, permissions: Array<out String>, grantResults: IntArray) {
         super.onRequestPermissionsResult(requestCode, permissions, grantResults)
         if (requestCode != REQUEST_PERMISSIONS) return
+        asked = true
         val required = requiredPermissions().toSet()
         val refused = permissions.indices.any { i ->
             permissions[i] in required && grantResults.getOrElse(i) { PackageManager.PERMISSION_DENIED } != PackageManager.PERMISSION_GRANTED
@@ -152,60 +211,208 @@ class MainActivity : Activity() {
 
     private fun showExplanation(show: Boolean) {
         permissionPanel.visibility = if (show) View.VISIBLE else View.GONE
+        val notes = mutableListOf<String>()
+        if (Build.VERSION.SDK_INT >= 29 && !granted(Manifest.permission.ACTIVITY_RECOGNITION)) notes += getString(R.string.note_no_activity)
+        if (Build.VERSION.SDK_INT >= 33 && !granted(Manifest.permission.POST_NOTIFICATIONS)) notes += getString(R.string.note_no_notifications)
+        permissionText.text = if (show) getString(R.string.permission_explanation) else ""
+        if (notes.isNotEmpty() && !show) info.text = notes.joinToString("\n")
         updateButtons()
+    }
+
+    private fun updateLocationPrompt(stats: SessionStats?) {
+        val lm = getSystemService(Context.LOCATION_SERVICE) as LocationManager
+        val on = stats?.locationEnabled ?: try {
+            if (Build.VERSION.SDK_INT >= 28) lm.isLocationEnabled else lm.isProviderEnabled(LocationManager.GPS_PROVIDER)
+        } catch (e: RuntimeException) {
+            true
+        }
+        locationPanel.visibility = if (on || missingPermissions().isNotEmpty()) View.GONE else View.VISIBLE
     }
 
     // ---- navigation / recording / replay ----------------------------------------------------
 
-    private fun toggleNavigation(record: Boolean) {
+    /** Long-press: the start of this session (now, if navigating) or of the next one only. */
+    fun declareStart(latDeg: Double, lonDeg: Double) {
+        val sigma = settings.startSigmaM
         val s = service
-        if (s?.session != null) {
-            NavigationService.stop(this)
-            main.postDelayed({ updateButtons() }, 100)
-            return
+        if (s != null && s.navigating) {
+            s.declareStart(latDeg, lonDeg, sigma)
+        } else {
+            pendingStart = doubleArrayOf(latDeg, lonDeg, sigma)
         }
+        mapController.showStart(org.osmdroid.util.GeoPoint(latDeg, lonDeg))
+        status.text = getString(R.string.status_start_set, latDeg, lonDeg, sigma)
+    }
+
+    private fun toggleNavigation() {
         if (missingPermissions().isNotEmpty()) {
             ensurePermissions()
             return
         }
-        NavigationService.start(this, navigate = true, record = record)
-        main.postDelayed({ updateButtons() }, 100)
+        val s = service
+        val nav = s?.navigating == true
+        val rec = s?.recording == true
+        NavigationService.set(this, navigate = !nav, record = rec, declaredStart = if (!nav) pendingStart else null)
+        if (!nav) pendingStart = null  // consumed by this session
     }
 
-    private fun handleReplayIntent(intent: Intent?) {
-        val path = intent?.getStringExtra(EXTRA_REPLAY) ?: return
-        replay?.cancel()
-        val name = File(path).name
-        val task = ReplayTask(path, settings.navigatorConfig(), REPLAY_SEED,
-            onProgress = { out, frac ->
-                main.post {
-                    showOutput(out, emptyList())
-                    status.text = getString(R.string.status_replaying, name, (frac * 100).toInt())
-                }
-            },
-            onDone = { out, err ->
-                main.post {
-                    if (out != null) showOutput(out, emptyList())
-                    if (err != null) status.text = err.message ?: err.toString()
-                }
-            })
-        replay = task
-        task.start()
+    private fun toggleRecording() {
+        if (missingPermissions().isNotEmpty()) {
+            ensurePermissions()
+            return
+        }
+        val s = service
+        NavigationService.set(this, navigate = s?.navigating == true, record = s?.recording != true)
     }
 
-    /** Shows one output: map layers and the status line (engine, status, reason). */
+    private fun startReplay(path: String) {
+        val s = service
+        if (s == null) {
+            pendingReplay = path
+            return
+        }
+        startService(Intent(this, NavigationService::class.java))  // outlives this Activity's binding
+        if (s.startReplay(path)) {
+            mapController.follow = true
+            updateFollow()
+        }
+        showInterrupted(null)
+    }
+
+    /** Checkpoint: the tester is at a known point; picked on the map (centre) or typed. */
+    private fun askCheckpoint() {
+        val lat = EditText(this).apply {
+            inputType = InputType.TYPE_CLASS_NUMBER or InputType.TYPE_NUMBER_FLAG_DECIMAL or InputType.TYPE_NUMBER_FLAG_SIGNED
+            setText(String.format(Locale.US, "%.7f", mapController.centerLatDeg))
+        }
+        val lon = EditText(this).apply {
+            inputType = lat.inputType
+            setText(String.format(Locale.US, "%.7f", mapController.centerLonDeg))
+        }
+        val form = LinearLayout(this).apply {
+            orientation = LinearLayout.VERTICAL
+            val p = Views.dp(context, 16)
+            setPadding(p, p, p, p)
+            addView(Views.label(context, getString(R.string.checkpoint_hint)))
+            addView(lat)
+            addView(lon)
+        }
+        AlertDialog.Builder(this).setTitle(R.string.action_checkpoint).setView(form)
+            .setPositiveButton(R.string.checkpoint_write) { _, _ ->
+                val a = lat.text.toString().toDoubleOrNull()
+                val b = lon.text.toString().toDoubleOrNull()
+                if (a == null || b == null || a !in -90.0..90.0 || b !in -180.0..180.0) {
+                    status.text = getString(R.string.checkpoint_invalid)
+                } else {
+                    writeCheckpoint(a, b)
+                }
+            }
+            .setNegativeButton(android.R.string.cancel, null)
+            .show()
+    }
+
+    /** Writes a Truth line at [latDeg], [lonDeg] now; false when no session runs. */
+    fun writeCheckpoint(latDeg: Double, lonDeg: Double): Boolean {
+        val ok = service?.checkpoint(latDeg, lonDeg) == true
+        status.text = if (ok) getString(R.string.checkpoint_written, latDeg, lonDeg) else getString(R.string.checkpoint_no_session)
+        return ok
+    }
+
+    /** Walkway graph and DEM bounds, read on a thread (once per pair of files). */
+    private fun loadMapData(centerOnDem: Boolean) {
+        val graph = settings.graphPath
+        val dem = settings.demPath
+        val key = "$graph|$dem"
+        if (key == mapDataKey || (graph.isEmpty() && dem.isEmpty())) return
+        mapDataKey = key
+        mapDataThread = Thread({
+            val data = MapData.load(graph, dem)
+            runOnUiThread {
+                mapController.showGraph(data.graphLines)
+                val b = data.demBounds
+                if (centerOnDem && b != null) mapController.centerOn(b)
+                data.error?.let { status.text = getString(R.string.status_error, it) }
+            }
+        }, "pdnav-mapdata").apply { start() }
+    }
+
+    private fun centerOnLastFix() {
+        if (missingPermissions().isNotEmpty()) return
+        val lm = getSystemService(Context.LOCATION_SERVICE) as LocationManager
+        val l = try {
+            lm.getLastKnownLocation(LocationManager.GPS_PROVIDER) ?: lm.getLastKnownLocation(LocationManager.NETWORK_PROVIDER)
+        } catch (e: SecurityException) {
+            null
+        } catch (e: IllegalArgumentException) {
+            null
+        }
+        if (l != null) mapController.centerOn(l.latitude, l.longitude)
+    }
+
+    private fun showInterrupted(f: File?) {
+        if (f == null) {
+            interruptedPanel.visibility = View.GONE
+            return
+        }
+        interruptedText.text = getString(R.string.interrupted_text, f.name)
+        interruptedPanel.tag = f.path
+        interruptedPanel.visibility = View.VISIBLE
+    }
+
+    /** Shows one output: map layers, the status line and the numbers (position, sigma, engine). */
     fun showOutput(out: NavOutput, track: List<DoubleArray>) {
         mapController.show(out, track)
         val e = out.estimate
         status.text = "${e.statusText()} · ${out.steps} steps"
+        info.text = if (e.valid && e.latDeg.isFinite()) {
+            val sigma = Math.sqrt((e.covEastEastM2 + e.covNorthNorthM2).coerceAtLeast(0.0))
+            String.format(Locale.US, "%.6f, %.6f  ±%.1f m (1σ)  %s", e.latDeg, e.lonDeg, sigma, e.engine.label)
+        } else {
+            getString(R.string.info_no_position)
+        }
     }
 
+    /** Live state: duration, size, rows per line type, GNSS epochs, magnetometer accuracy, satellites. */
+    fun showStats(s: SessionStats) {
+        val lines = mutableListOf<String>()
+        lines += if (s.recording) s.recordingLine() else getString(R.string.state_not_recording, SessionStats.hms(s.durationNs))
+        lines += getString(R.string.counters_gnss, s.gnssEpochs, s.fixes, s.satellites.count { it.usedInFix }, s.satellites.size)
+        lines += s.sensorRows.entries.sortedBy { it.key }.joinToString(" · ") { "${it.key} ${it.value}" }
+        lines += getString(R.string.counters_mag, magAccuracyText(s.magAccuracy))
+        if (s.recording) lines += s.countsLine()
+        if (s.lateRows > 0) lines += getString(R.string.counters_late, s.lateRows, s.lastLate ?: "")
+        s.checkpoints.lastOrNull()?.let { c ->
+            lines += String.format(Locale.US, "checkpoint: %.1f m off (±%.1f m, %s)", c.errorM, c.sigmaM, c.engine)
+        }
+        counters.text = lines.joinToString("\n")
+        skyPlot.satellites = s.satellites
+        s.lastFix?.let { mapController.showFix(it.latDeg, it.lonDeg, it.accuracyM) }
+        updateLocationPrompt(s)
+    }
+
+    private fun magAccuracyText(a: Int): String = when (a) {
+        3 -> getString(R.string.mag_high)
+        2 -> getString(R.string.mag_medium)
+        1, 0 -> getString(R.string.mag_low)
+        else -> getString(R.string.mag_unknown)
+    }
+
+    /** Buttons from the service's state (called on every state change, never on a timer). */
     private fun updateButtons() {
-        val running = service?.session != null
+        val s = service
         val allowed = missingPermissions().isEmpty()
-        navigateButton.text = getString(if (running) R.string.action_stop else R.string.action_navigate)
-        navigateButton.isEnabled = allowed
-        recordButton.isEnabled = allowed && !running
+        val nav = s?.navigating == true
+        val rec = s?.recording == true
+        val replaying = s?.replay != null
+        navigateButton.text = getString(if (nav) R.string.action_stop_navigate else R.string.action_navigate)
+        recordButton.text = getString(if (rec) R.string.action_stop_record else R.string.action_record)
+        navigateButton.isEnabled = allowed && !replaying
+        recordButton.isEnabled = allowed && !replaying
+        checkpointButton.isEnabled = s?.session != null
+    }
+
+    private fun updateFollow() {
+        followButton.text = getString(if (mapController.follow) R.string.action_follow_on else R.string.action_follow_off)
     }
 
     // ---- layout -------------------------------------------------------------------------------
@@ -216,40 +423,83 @@ class MainActivity : Activity() {
         mapController = MapController(this, map)
         root.addView(map, FrameLayout.LayoutParams(-1, -1))
 
-        status = TextView(this).apply {
-            id = R.id.status_text
-            setBackgroundColor(Color.argb(200, 255, 255, 255))
-            setPadding(24, 16, 24, 16)
+        val pad = Views.dp(this, 8)
+        status = TextView(this).apply { id = R.id.status_text }
+        info = TextView(this).apply { id = R.id.info_text }
+        counters = TextView(this).apply { id = R.id.counters_text; textSize = 11f }
+        skyPlot = SkyPlotView(this).apply { id = R.id.sky_plot; visibility = View.GONE }
+        locationPanel = LinearLayout(this).apply {
+            id = R.id.location_panel
+            orientation = LinearLayout.HORIZONTAL
+            visibility = View.GONE
+            addView(TextView(context).apply { text = getString(R.string.location_off) }, LinearLayout.LayoutParams(0, -2, 1f))
+            addView(Views.button(context, R.id.location_settings, getString(R.string.location_open)) {
+                startActivity(Intent(Settings.ACTION_LOCATION_SOURCE_SETTINGS))
+            })
         }
-        root.addView(status, FrameLayout.LayoutParams(-1, -2, Gravity.TOP))
+        interruptedPanel = LinearLayout(this).apply {
+            id = R.id.interrupted_panel
+            orientation = LinearLayout.HORIZONTAL
+            visibility = View.GONE
+        }
+        interruptedText = TextView(this)
+        interruptedPanel.addView(interruptedText, LinearLayout.LayoutParams(0, -2, 1f))
+        interruptedPanel.addView(Views.button(this, R.id.interrupted_replay, getString(R.string.action_replay)) {
+            (interruptedPanel.tag as? String)?.let { startReplay(it) }
+        })
+        val top = LinearLayout(this).apply {
+            orientation = LinearLayout.VERTICAL
+            setBackgroundColor(Color.argb(210, 255, 255, 255))
+            setPadding(pad * 2, pad, pad * 2, pad)
+            addView(status)
+            addView(info)
+            addView(counters)
+            addView(locationPanel)
+            addView(interruptedPanel)
+            addView(skyPlot, LinearLayout.LayoutParams(-1, Views.dp(context, 200)))
+        }
+        root.addView(top, FrameLayout.LayoutParams(-1, -2, Gravity.TOP))
 
-        navigateButton = Views.button(this, R.id.button_navigate, getString(R.string.action_navigate)) { toggleNavigation(record = false) }
-        recordButton = Views.button(this, R.id.button_record, getString(R.string.action_record)) { toggleNavigation(record = true) }
+        navigateButton = Views.button(this, R.id.button_navigate, getString(R.string.action_navigate)) { toggleNavigation() }
+        recordButton = Views.button(this, R.id.button_record, getString(R.string.action_record)) { toggleRecording() }
+        checkpointButton = Views.button(this, R.id.button_checkpoint, getString(R.string.action_checkpoint)) { askCheckpoint() }
+        followButton = Views.button(this, R.id.button_follow, getString(R.string.action_follow_on)) {
+            mapController.follow = !mapController.follow
+            updateFollow()
+        }
+        val satButton = Views.button(this, R.id.button_satellites, getString(R.string.action_satellites)) {
+            skyPlot.visibility = if (skyPlot.visibility == View.VISIBLE) View.GONE else View.VISIBLE
+        }
         val settingsButton = Views.button(this, R.id.button_settings, getString(R.string.action_settings)) {
             startActivity(Intent(this, SettingsActivity::class.java))
         }
         val sessionsButton = Views.button(this, R.id.button_sessions, getString(R.string.action_sessions)) {
             startActivity(Intent(this, SessionsActivity::class.java))
         }
-        root.addView(Views.row(this, navigateButton, recordButton, settingsButton, sessionsButton),
-            FrameLayout.LayoutParams(-1, -2, Gravity.BOTTOM))
+        val bottom = LinearLayout(this).apply {
+            orientation = LinearLayout.VERTICAL
+            addView(Views.row(context, navigateButton, recordButton, checkpointButton))
+            addView(Views.row(context, followButton, satButton, settingsButton, sessionsButton))
+        }
+        root.addView(bottom, FrameLayout.LayoutParams(-1, -2, Gravity.BOTTOM))
 
+        permissionText = TextView(this).apply { id = R.id.permission_text }
         permissionPanel = LinearLayout(this).apply {
             id = R.id.permission_panel
             orientation = LinearLayout.VERTICAL
             setBackgroundColor(Color.WHITE)
-            setPadding(48, 48, 48, 48)
+            val p = Views.dp(context, 24)
+            setPadding(p, p, p, p)
             visibility = View.GONE
-            addView(TextView(this@MainActivity).apply {
-                id = R.id.permission_text
-                text = getString(R.string.permission_explanation)
-            })
+            addView(permissionText)
             addView(Views.button(this@MainActivity, R.id.permission_retry, getString(R.string.permission_retry)) { ensurePermissions() })
-            addView(Views.button(this@MainActivity, View.NO_ID, getString(R.string.permission_open_settings)) {
+            addView(Views.button(this@MainActivity, R.id.permission_settings, getString(R.string.permission_open_settings)) {
                 startActivity(Intent(Settings.ACTION_APPLICATION_DETAILS_SETTINGS, Uri.fromParts("package", packageName, null)))
             })
         }
         root.addView(permissionPanel, FrameLayout.LayoutParams(-1, -2, Gravity.CENTER))
+        Views.applySystemBarInsets(root, top, bottom)
+        updateFollow()
         return root
     }
 
@@ -258,6 +508,7 @@ class MainActivity : Activity() {
     companion object {
         const val REQUEST_PERMISSIONS = 1
         const val EXTRA_REPLAY = "org.pdnav.app.extra.REPLAY"
-        private const val REPLAY_SEED = 1L
+        private const val STATE_START = "pending_start"
+        private const val STATE_ASKED = "permissions_asked"
     }
 }
