@@ -41,6 +41,8 @@ struct EvalArgs {
   double min_length_m = 1000.0;
   double max_length_m = 5000.0;
   bool no_monitor = false;
+  bool no_anchor = false;         // ablations of the issue-17 additions (direct path)
+  bool no_uninformative = false;
   std::string path = "app";
   double user_height_m = 1.75;
   std::string tmp_dir;  // empty: the system temp directory
@@ -138,6 +140,8 @@ int run_eval(const EvalArgs& a) {
   opt.particles = a.particles;
   opt.resampling = terrain::resampling_from_string(a.resampling);
   opt.residual_monitor = !a.no_monitor;
+  if (a.no_anchor) opt.anchor_start_bias = false;
+  if (a.no_uninformative) opt.uninformative_relief_sigmas = 0.0;
   terrain::WalkSimOptions sim;
   sim.min_length_m = a.min_length_m;
   sim.max_length_m = a.max_length_m;
@@ -147,8 +151,10 @@ int run_eval(const EvalArgs& a) {
   std::printf("# eval-terrain: dem %s, %d walks, seed %llu, %d particles, preset %s, resampling %s, path %s\n",
               a.dem.c_str(), a.walks, static_cast<unsigned long long>(a.seed), a.particles, a.preset.c_str(),
               a.resampling.c_str(), a.path.c_str());
-  if (app && (a.resampling != "multinomial" || a.no_monitor))
-    throw std::invalid_argument("--resampling / --no-monitor are ablations of --path direct (the Navigator uses the preset)");
+  if (app && (a.resampling != "multinomial" || a.no_monitor || a.no_anchor || a.no_uninformative))
+    throw std::invalid_argument(
+        "--resampling / --no-monitor / --no-anchor / --no-uninformative are ablations of --path direct (the Navigator "
+        "uses the preset)");
   std::printf("# coverage = fraction of steps with the truth inside the 1-sigma ellipse (68.27 %% content,\n"
               "# Mahalanobis^2 <= 2.296); cov_unit = inside the unit-covariance ellipse (39.35 %% content)\n");
   std::printf("%4s %9s %10s %10s %7s %9s %9s %9s %9s %6s\n", "walk", "length_m", "dr_drms_m", "pf_drms_m", "ratio",
@@ -223,6 +229,8 @@ void register_eval_terrain(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--tmp-dir", a->tmp_dir, "where the app path writes each walk's log (removed after)");
   cmd->add_flag("--no-monitor", a->no_monitor, "disable residual monitoring (ablation)");
+  cmd->add_flag("--no-anchor", a->no_anchor, "every particle's baro bias starts at 0, the paper's (ablation)");
+  cmd->add_flag("--no-uninformative", a->no_uninformative, "never skip updates on featureless terrain (ablation)");
   cmd->callback([a]() {
     const int rc = run_eval(*a);
     if (rc != 0) throw CLI::RuntimeError(rc);

@@ -171,7 +171,8 @@ class TerrainEngine {
 
   /// Weighted mean and covariance (Eq. 8-9), status and reason: kAmbiguous with the modes
   /// in the reason when the cloud is multimodal (the mean and covariance then span them);
-  /// kDegraded "terrain uninformative" on featureless terrain. Cached until the next feed.
+  /// kDegraded "terrain uninformative" on featureless terrain. Cached until the next feed (the
+  /// cache makes concurrent calls on one engine unsafe; one engine belongs to one thread).
   Estimate estimate() const;
   /// The modes of the cloud (one when unimodal; heaviest first; empty before the start).
   std::vector<TerrainMode> modes() const;
