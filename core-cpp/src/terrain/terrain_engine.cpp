@@ -706,32 +706,29 @@ struct TerrainEngine::Impl {
   /// smoothed twice with [1 2 1]/4, cut at valleys deeper than mode_valley_fraction of the
   /// smaller neighbouring peak; groups lighter than mode_min_weight join their neighbour
   /// across the shallower cut, groups closer than mode_min_separation_m merge.
+  /// Empty: one mode, the estimate itself (a cloud narrower than mode_min_separation_m / 4).
   std::vector<Moments> find_modes(const Eigen::Vector2d& mean, const Eigen::Matrix2d& cov) const {
-    Moments all;
-    for (std::size_t i = 0; i < count; ++i) all.add(w[i], p.e[i], p.n[i]);
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
     const double major_sd = std::sqrt(std::max(0.0, eig.eigenvalues()(1)));
-    if (!(major_sd > 0.25 * opt.mode_min_separation_m) || !(all.w > 0)) return {all};
+    if (!(major_sd > 0.25 * opt.mode_min_separation_m)) return {};
     const Eigen::Vector2d u = eig.eigenvectors().col(1);
     constexpr int kBins = 48;
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (std::size_t i = 0; i < count; ++i) {
-      if (!(w[i] > 0.0f)) continue;
-      const double x = (p.e[i] - mean.x()) * u.x() + (p.n[i] - mean.y()) * u.y();
-      lo = std::min(lo, x);
-      hi = std::max(hi, x);
-    }
-    if (!(hi > lo)) return {all};
+    // +-4 sigma along the major axis (one pass; particles beyond go to the end bins).
+    const double lo = -4.0 * major_sd, hi = 4.0 * major_sd;
     const double scale = kBins / (hi - lo) * (1.0 - 1e-9);
     std::array<double, kBins> h{};
     std::array<Moments, kBins> bin{};
+    Moments all;
     for (std::size_t i = 0; i < count; ++i) {
       if (!(w[i] > 0.0f)) continue;
       const double x = (p.e[i] - mean.x()) * u.x() + (p.n[i] - mean.y()) * u.y();
-      const int b = std::clamp(static_cast<int>((x - lo) * scale), 0, kBins - 1);
+      const double f = (x - lo) * scale;  // NaN and far-out particles land in the end bins
+      const int b = f > 0.0 ? (f < kBins - 1.0 ? static_cast<int>(f) : kBins - 1) : 0;
       h[b] += w[i];
       bin[b].add(w[i], p.e[i], p.n[i]);
     }
+    for (const Moments& m : bin) all.add(m);
+    if (!(all.w > 0)) return {};
     for (int pass = 0; pass < 2; ++pass) {
       std::array<double, kBins> g{};
       for (int b = 0; b < kBins; ++b)
@@ -822,6 +819,14 @@ struct TerrainEngine::Impl {
     est.position.h_m = ground.valid() ? ground.elevation_m : 0.0;  // DEM datum (docs/terrain.md)
     est.vertical_sigma_m = std::sqrt(opt.measurement_var_m2);
     const std::vector<Moments> groups = find_modes(est.en_m, est.cov_en_m2);
+    if (groups.empty()) {
+      TerrainMode m;
+      m.en_m = est.en_m;
+      m.cov_en_m2 = est.cov_en_m2;
+      m.weight = 1.0;
+      m.position = dem->to_geodetic(m.en_m.x(), m.en_m.y());
+      cache_modes.push_back(m);
+    }
     for (const Moments& g : groups) {
       TerrainMode m;
       m.en_m = g.mean();
