@@ -68,7 +68,8 @@ std::vector<Sample> walk_to_samples(const terrain::SimulatedWalk& w, const terra
     const PdrStep& s = w.steps[k];
     while (ip < w.pressure.size() && w.pressure[ip].t_ns <= s.t_ns) out.emplace_back(pressure(ip++));
     const TimeNs t_rv = s.t_ns - kNsPerMs;  // the heading sensor reports just before the step event
-    out.emplace_back(chest_rotation_for_heading(t_rv, utc_of(t_rv), s.heading_rad - declination_rad, s.heading_sigma_rad));
+    out.emplace_back(
+        chest_rotation_for_heading(t_rv, utc_of(t_rv), s.heading_rad - declination_rad, s.heading_sigma_rad));
     StepDetectorSample sd;
     sd.t_ns = s.t_ns;
     sd.utc_ms = utc_of(s.t_ns);

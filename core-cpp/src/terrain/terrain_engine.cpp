@@ -702,7 +702,7 @@ struct TerrainEngine::Impl {
     }
   };
 
-  /// Modes along the cloud's major axis: a 48-bin weighted histogram of the projections,
+  /// Modes along the cloud's major axis: a 48-bin weighted histogram of the projections (+-4 sigma),
   /// smoothed twice with [1 2 1]/4, cut at valleys deeper than mode_valley_fraction of the
   /// smaller neighbouring peak; groups lighter than mode_min_weight join their neighbour
   /// across the shallower cut, groups closer than mode_min_separation_m merge.
