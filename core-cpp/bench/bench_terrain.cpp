@@ -37,7 +37,7 @@ std::shared_ptr<const Dem> bench_dem() {
   return dem;
 }
 
-void run(benchmark::State& state, Resampling scheme) {
+void run(benchmark::State& state, Resampling scheme, bool with_estimate = false) {
   TerrainOptions o = TerrainOptions::srtm_tuned();
   o.particles = static_cast<int>(state.range(0));
   o.resampling = scheme;
@@ -60,6 +60,7 @@ void run(benchmark::State& state, Resampling scheme) {
     s.length_m = 0.7;
     s.heading_rad = heading;
     pf.feed(s);
+    if (with_estimate) benchmark::DoNotOptimize(pf.estimate());  // the Navigator asks after every sample
   }
   const double particle_steps = static_cast<double>(state.iterations()) * static_cast<double>(o.particles);
   state.counters["ns_per_particle_step"] =
@@ -72,9 +73,13 @@ void run(benchmark::State& state, Resampling scheme) {
 void BM_TerrainStep_Multinomial(benchmark::State& s) { run(s, Resampling::kMultinomial); }
 void BM_TerrainStep_Systematic(benchmark::State& s) { run(s, Resampling::kSystematic); }
 void BM_TerrainStep_Stratified(benchmark::State& s) { run(s, Resampling::kStratified); }
+// The app's cost: a step plus the estimate (mean, covariance, the mode search and the
+// status), at the Navigator's 500 particles and beyond.
+void BM_TerrainStepAndEstimate(benchmark::State& s) { run(s, Resampling::kMultinomial, true); }
 
 BENCHMARK(BM_TerrainStep_Multinomial)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_TerrainStep_Systematic)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TerrainStepAndEstimate)->Arg(500)->Arg(2000)->Arg(10000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_TerrainStep_Stratified)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

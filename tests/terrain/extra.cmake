@@ -8,6 +8,7 @@ file(MAKE_DIRECTORY "${PDNAV_TERRAIN_SCRATCH}")
 # pdnav_terrain_area(NAME LAT LON TEST): tile `<NAME>_30m.pdem` (24 x 24 km around LAT LON,
 # 30 m cells, voids filled) made by test `terrain.make_<NAME>_tile`, and the bar test TEST on it.
 function(pdnav_terrain_area name lat lon test)
+  set(eval_args ${ARGN})
   set(tile "${PDNAV_TERRAIN_SCRATCH}/${name}_30m.pdem")
   add_test(NAME terrain.make_${name}_tile
     COMMAND ${CMAKE_COMMAND} -E env /usr/bin/python3 "${PROJECT_SOURCE_DIR}/dem-tools/pdnav_dem.py" tile
@@ -16,14 +17,23 @@ function(pdnav_terrain_area name lat lon test)
   set_tests_properties(terrain.make_${name}_tile PROPERTIES FIXTURES_SETUP terrain_tile_${name}
                        LABELS "terrain;dem-tools")
   add_test(NAME ${test}
-    COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/terrain/check_eval_bar.py" "$<TARGET_FILE:pdnav>" "${tile}")
+    COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/terrain/check_eval_bar.py" "$<TARGET_FILE:pdnav>" "${tile}"
+            ${eval_args})
   set_tests_properties(${test} PROPERTIES FIXTURES_REQUIRED terrain_tile_${name} LABELS "terrain;cli" TIMEOUT 300)
 endfunction()
 
-pdnav_terrain_area(andorra 42.55 1.55 terrain.eval_bar)
+pdnav_terrain_area(andorra 42.55 1.55 terrain.eval_bar --path direct)
 # Generalisation: the same bar, no parameter changed, on a second area 40 km west-north-west
 # (Pallars Sobira, 414-2767 m).
-pdnav_terrain_area(pallars 42.85 1.15 terrain.eval_bar_other_area)
+pdnav_terrain_area(pallars 42.85 1.15 terrain.eval_bar_other_area --path direct)
+# Issue 17: the app's path (session log writer, reader, PDR, Navigator, as `pdnav replay`) with
+# the per-area bar (median ratio <= 0.45, 68 % coverage 0.60-0.80); the full bar over 6 areas x
+# 3 seeds is tools/terrain-areas (docs/terrain.md).
+add_test(NAME terrain.eval_bar_app_path
+  COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/terrain/check_eval_bar.py" "$<TARGET_FILE:pdnav>"
+          "${PDNAV_TERRAIN_TILE}" --bar 0.45,0.60,0.80 --path app --tmp-dir "${PDNAV_TERRAIN_SCRATCH}")
+set_tests_properties(terrain.eval_bar_app_path PROPERTIES FIXTURES_REQUIRED terrain_tile_andorra
+                     LABELS "terrain;cli" TIMEOUT 300)
 
 add_test(NAME terrain.simulate_log
   COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/terrain/check_simulate.py"

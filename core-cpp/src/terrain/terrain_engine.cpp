@@ -5,11 +5,15 @@
 #include "pdnav/terrain/terrain_engine.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <iomanip>
 #include <sstream>
 #include <stdexcept>
+
+#include <Eigen/Eigenvalues>
 
 #include "fast_math.h"
 
@@ -26,9 +30,11 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// Particle state as structure of arrays.
 struct Particles {
   std::vector<float> e, n, bh, bb, sc;  // sc: step-length scale error (beyond the paper)
+  std::vector<float> an;  // start anchoring: DEM(declared start) - DEM(own start), constant
   std::vector<float> h0;  // DEM elevation at the last update (segment_mean_elevation; NaN = none)
   void resize(std::size_t count) {
     sc.assign(count, 0.0f);
+    an.assign(count, 0.0f);
     h0.assign(count, std::numeric_limits<float>::quiet_NaN());
     e.assign(count, 0.0f);
     n.assign(count, 0.0f);
@@ -41,6 +47,7 @@ struct Particles {
     bh[dst_i] = src.bh[src_i];
     bb[dst_i] = src.bb[src_i];
     sc[dst_i] = src.sc[src_i];
+    an[dst_i] = src.an[src_i];
     h0[dst_i] = src.h0[src_i];
   }
 };
@@ -140,6 +147,12 @@ struct TerrainEngine::Impl {
   TimeNs recovering_until_ns = std::numeric_limits<TimeNs>::min();
   std::string alarm;            // last residual-monitor alarm
   TerrainStats stats;
+  std::string start_err;        // why the last initialize() was refused
+  bool h0_stale = false;        // an update was skipped: segment-start elevations are stale
+  std::uint64_t version = 0;    // bumped by every change the estimate can see
+  mutable std::uint64_t cache_version = ~std::uint64_t{0};
+  mutable Estimate cache_est;
+  mutable std::vector<TerrainMode> cache_modes;
 
   Impl(const TerrainOptions& o, std::shared_ptr<const Dem> d, std::uint64_t seed)
       : opt(o), dem(std::move(d)), rng(seed) {
@@ -163,11 +176,43 @@ struct TerrainEngine::Impl {
 
   bool recovering() const { return t_ns < recovering_until_ns; }
 
-  void initialize(const geo::Geodetic& start, double sigma_m, TimeNs t) {
+  double start_sigma(double sigma_m) const {
+    return std::isfinite(sigma_m) && sigma_m > 0 ? sigma_m : opt.initial_sigma_m;
+  }
+
+  /// Empty when the start area fits the tile (or the start is off the tile / on a void: that
+  /// start is accepted as degraded dead reckoning), else the reason for refusing it.
+  std::string start_problem(const geo::Geodetic& start, double sigma_m) const {
     const Eigen::Vector2d en = dem->to_local(start);
-    const auto s = static_cast<float>(std::isfinite(sigma_m) && sigma_m > 0 ? sigma_m : opt.initial_sigma_m);
+    if (!en.allFinite() || !dem->at_local(en.x(), en.y()).valid()) return {};
+    const double s = start_sigma(sigma_m);
+    const double reach = opt.start_coverage_sigmas * s;
+    const double beyond = std::max({dem->min_e_m() - (en.x() - reach), (en.x() + reach) - dem->max_e_m(),
+                                    dem->min_n_m() - (en.y() - reach), (en.y() + reach) - dem->max_n_m()});
+    if (!(beyond > 0.0)) return {};
+    std::ostringstream os;
+    os.precision(9);
+    os << "terrain: start sigma " << s << " m refused: the " << opt.start_coverage_sigmas << "-sigma start area (+-"
+       << reach << " m around " << start.lat_deg() << ", " << start.lon_deg() << ") reaches " << beyond
+       << " m beyond the DEM tile (" << dem->max_e_m() - dem->min_e_m() << " x " << dem->max_n_m() - dem->min_n_m()
+       << " m); declare a tighter start or use a larger tile";
+    return os.str();
+  }
+
+  void initialize(const geo::Geodetic& start, double sigma_m, TimeNs t) {
+    ++version;
+    start_err = start_problem(start, sigma_m);
+    if (!start_err.empty()) {
+      initialized = false;
+      t_ns = t;
+      return;
+    }
+    const Eigen::Vector2d en = dem->to_local(start);
+    const auto s = static_cast<float>(start_sigma(sigma_m));
     const auto hs = static_cast<float>(opt.heading_bias_sigma_rad);
     const auto bs = static_cast<float>(opt.baro_bias_sigma_m);
+    const DemSample ground = dem->at_local(en.x(), en.y());
+    const auto h_start = static_cast<float>(ground.valid() ? ground.elevation_m : kNaN);
     for (std::size_t i = 0; i < count; ++i) {
       p.e[i] = static_cast<float>(en.x()) + s * normal();
       p.n[i] = static_cast<float>(en.y()) + s * normal();
@@ -175,8 +220,15 @@ struct TerrainEngine::Impl {
       p.bb[i] = opt.rao_blackwell_baro_bias ? 0.0f : bs * normal();
       p.sc[i] = static_cast<float>(opt.step_scale_sigma) * normal();
       p.h0[i] = dem->elevation_or_nan(p.e[i], p.n[i]);
+      // The barometer reads DEM(declared start) at the start; a particle that starts at x_i
+      // explains that reading only with the offset DEM(declared) - DEM(x_i) (docs/terrain.md).
+      const float an = h_start - p.h0[i];
+      p.an[i] = an == an && opt.anchor_start_bias ? an : 0.0f;
       w[i] = 1.0f;
     }
+    h0_stale = false;
+    stats.uninformative = false;
+    stats.relief_m = 0.0;
     w_sum = sum_sq = static_cast<double>(count);
     t_ns = t;
     initialized = true;
@@ -189,7 +241,6 @@ struct TerrainEngine::Impl {
     nis_filled = nis_next = 0;
     recovering_until_ns = std::numeric_limits<TimeNs>::min();
     alarm.clear();
-    const DemSample ground = dem->at_local(en.x(), en.y());
     baro_usable = ground.valid();
     if (baro_usable) {
       // Hypsometric formula referenced at the start: ISA temperature at the start elevation.
@@ -219,6 +270,13 @@ struct TerrainEngine::Impl {
 
   void feed_pressure(const PressureSample& s) {
     if (!initialized || !baro_usable) return;
+    const bool stuck_before = stats.baro_stuck;
+    const std::int64_t jumps_before = stats.baro_jumps;
+    feed_pressure_checked(s);
+    if (stats.baro_stuck != stuck_before || stats.baro_jumps != jumps_before) ++version;  // the reason changes
+  }
+
+  void feed_pressure_checked(const PressureSample& s) {
     const double pa = s.pressure_pa;
     if (!std::isfinite(pa) || pa < 25e3 || pa > 115e3) {  // outside any surface pressure
       ++stats.baro_rejected;
@@ -271,12 +329,23 @@ struct TerrainEngine::Impl {
     double dt_s = ns_to_s(step.t_ns) - ns_to_s(t_ns);  // no int64 overflow on wild times
     if (!(dt_s >= 0.0)) dt_s = 0.0;
     t_ns = step.t_ns;
+    ++version;
     ++stats.steps;
     walked_since_update_m += step.length_m;
-    const bool measure = baro_usable && baro_count > 0 && walked_since_update_m >= opt.update_distance_m;
+    bool measure = baro_usable && baro_count > 0 && walked_since_update_m >= opt.update_distance_m;
+    const bool due = measure;
+    if (measure && opt.uninformative_relief_sigmas > 0.0) {
+      stats.relief_m = relief_around_cloud();
+      stats.uninformative = stats.relief_m < opt.uninformative_relief_sigmas * std::sqrt(opt.measurement_var_m2);
+      if (stats.uninformative) {  // featureless: the update could only lock on DEM noise
+        ++stats.uninformative_updates;
+        measure = false;
+        h0_stale = true;
+      }
+    }
     const double z = measure ? baro_sum_m / baro_count : kNaN;
     propagate_and_weight(step, dt_s, z);
-    if (measure) {
+    if (due) {
       restart_baro_average();
       walked_since_update_m = 0.0;
     }
@@ -286,6 +355,43 @@ struct TerrainEngine::Impl {
   }
 
   double sum_sq = 0.0;  // sum of squared unnormalised weights (for Neff)
+
+  /// DEM relief around the cloud: 1-sigma of the elevations at the cloud's weighted mean and
+  /// on rings of radius r/2 (8 points) and r (16 points), r = max(informative_radius_m,
+  /// 2 sigma of the cloud). Mean and sigma from 64 evenly strided particles (a relief scale,
+  /// not an estimate). Voids and off-tile points are left out (0 when fewer than 3 remain).
+  double relief_around_cloud() const {
+    const std::size_t stride = std::max<std::size_t>(1, count / 64);
+    double sw = 0, se = 0, sn = 0, see = 0, snn = 0;
+    for (std::size_t i = 0; i < count; i += stride) {
+      const double wi = w[i], e = p.e[i], n = p.n[i];
+      sw += wi;
+      se += wi * e;
+      sn += wi * n;
+      see += wi * e * e;
+      snn += wi * n * n;
+    }
+    if (!(sw > 0.0)) return 0.0;
+    const double me = se / sw, mn = sn / sw;
+    const double var = std::max(0.0, see / sw - me * me) + std::max(0.0, snn / sw - mn * mn);
+    const double r = std::max(opt.informative_radius_m, 2.0 * std::sqrt(0.5 * var));
+    double s1 = 0, s2 = 0;
+    int k = 0;
+    auto add = [&](double e, double n) {
+      const DemSample h = dem->at_local(e, n);
+      if (!h.valid()) return;
+      s1 += h.elevation_m;
+      s2 += h.elevation_m * h.elevation_m;
+      ++k;
+    };
+    add(me, mn);
+    for (int j = 0; j < 8; ++j) add(me + 0.5 * r * std::sin(j * kPi / 4), mn + 0.5 * r * std::cos(j * kPi / 4));
+    for (int j = 0; j < 16; ++j)
+      add(me + r * std::sin(j * kPi / 8 + kPi / 16), mn + r * std::cos(j * kPi / 8 + kPi / 16));
+    if (k < 3) return 0.0;
+    const double mean = s1 / k;
+    return std::sqrt(std::max(0.0, s2 / k - mean * mean));
+  }
 
   double neff_fraction() const {
     if (!(sum_sq > 0.0)) return 1.0;
@@ -321,7 +427,10 @@ struct TerrainEngine::Impl {
     float* pbb = p.bb.data();
     const float* psc = p.sc.data();
     float* ph0 = p.h0.data();
-    const bool segment = opt.segment_mean_elevation;
+    const float* pan = p.an.data();
+    const bool segment = opt.segment_mean_elevation && !h0_stale;
+    const bool track_h0 = opt.segment_mean_elevation;
+    if (measure) h0_stale = false;
     float* pr = resid.data();
     for (std::size_t i = 0; i < count; ++i) {
       const std::uint64_t r1 = rng.next();
@@ -340,11 +449,9 @@ struct TerrainEngine::Impl {
       if (measure) {
         const float h = d.elevation_or_nan(pe[i], pn[i]);  // NaN = void / off the tile
         float pred = h;
-        if (segment) {
-          pred = ph0[i] == ph0[i] ? 0.5f * (ph0[i] + h) : h;  // segment mean (trapezoid)
-          ph0[i] = h;
-        }
-        pr[i] = zf - (pred + pbb[i]);
+        if (segment) pred = ph0[i] == ph0[i] ? 0.5f * (ph0[i] + h) : h;  // segment mean (trapezoid)
+        if (track_h0) ph0[i] = h;
+        pr[i] = zf - (pred + pbb[i] + pan[i]);
       }
     }
     if (!measure) return;
@@ -557,12 +664,135 @@ struct TerrainEngine::Impl {
     }
   }
 
-  Estimate estimate() const {
+  /// The estimate and the modes, recomputed only when something they depend on changed.
+  void refresh() const {
+    if (cache_version == version) return;
+    cache_modes.clear();
+    cache_est = compute_estimate();
+    cache_version = version;
+  }
+
+  /// Weighted moments of a group of particles.
+  struct Moments {
+    double w = 0, e = 0, n = 0, ee = 0, nn = 0, en = 0;
+    void add(double wi, double x, double y) {
+      w += wi;
+      e += wi * x;
+      n += wi * y;
+      ee += wi * x * x;
+      nn += wi * y * y;
+      en += wi * x * y;
+    }
+    void add(const Moments& o) {
+      w += o.w;
+      e += o.e;
+      n += o.n;
+      ee += o.ee;
+      nn += o.nn;
+      en += o.en;
+    }
+    Eigen::Vector2d mean() const { return w > 0 ? Eigen::Vector2d(e / w, n / w) : Eigen::Vector2d::Zero(); }
+    Eigen::Matrix2d cov() const {
+      const Eigen::Vector2d m = mean();
+      Eigen::Matrix2d c;
+      c(0, 0) = std::max(0.0, ee / w - m.x() * m.x());
+      c(1, 1) = std::max(0.0, nn / w - m.y() * m.y());
+      c(0, 1) = c(1, 0) = en / w - m.x() * m.y();
+      return w > 0 ? c : Eigen::Matrix2d::Zero();
+    }
+  };
+
+  /// Modes along the cloud's major axis: a 48-bin weighted histogram of the projections (+-4 sigma),
+  /// smoothed twice with [1 2 1]/4, cut at valleys deeper than mode_valley_fraction of the
+  /// smaller neighbouring peak; groups lighter than mode_min_weight join their neighbour
+  /// across the shallower cut, groups closer than mode_min_separation_m merge.
+  /// Empty: one mode, the estimate itself (a cloud narrower than mode_min_separation_m / 4).
+  std::vector<Moments> find_modes(const Eigen::Vector2d& mean, const Eigen::Matrix2d& cov) const {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+    const double major_sd = std::sqrt(std::max(0.0, eig.eigenvalues()(1)));
+    if (!(major_sd > 0.25 * opt.mode_min_separation_m)) return {};
+    const Eigen::Vector2d u = eig.eigenvectors().col(1);
+    constexpr int kBins = 48;
+    // +-4 sigma along the major axis (one pass; particles beyond go to the end bins).
+    const double lo = -4.0 * major_sd, hi = 4.0 * major_sd;
+    const double scale = kBins / (hi - lo) * (1.0 - 1e-9);
+    std::array<double, kBins> h{};
+    std::array<Moments, kBins> bin{};
+    Moments all;
+    for (std::size_t i = 0; i < count; ++i) {
+      if (!(w[i] > 0.0f)) continue;
+      const double x = (p.e[i] - mean.x()) * u.x() + (p.n[i] - mean.y()) * u.y();
+      const double f = (x - lo) * scale;  // NaN and far-out particles land in the end bins
+      const int b = f > 0.0 ? (f < kBins - 1.0 ? static_cast<int>(f) : kBins - 1) : 0;
+      h[b] += w[i];
+      bin[b].add(w[i], p.e[i], p.n[i]);
+    }
+    for (const Moments& m : bin) all.add(m);
+    if (!(all.w > 0)) return {};
+    for (int pass = 0; pass < 2; ++pass) {
+      std::array<double, kBins> g{};
+      for (int b = 0; b < kBins; ++b)
+        g[b] = 0.25 * (b > 0 ? h[b - 1] : 0.0) + 0.5 * h[b] + 0.25 * (b + 1 < kBins ? h[b + 1] : 0.0);
+      h = g;
+    }
+    // Cuts: walk left to right keeping the highest peak since the last cut.
+    std::vector<int> cuts;      // a cut at b: bins < b on the left
+    std::vector<double> depth;  // valley / smaller peak at each cut (smaller = deeper)
+    int peak = 0, valley = 0;  // highest bin since the last cut; lowest bin after it (== peak: none)
+    for (int b = 1; b < kBins; ++b) {
+      if (valley == peak || h[b] < h[valley]) valley = b;
+      const double smaller = std::min(h[peak], h[b]);
+      if (valley != b && h[valley] < opt.mode_valley_fraction * smaller) {  // rising out of a deep valley
+        cuts.push_back(valley);
+        depth.push_back(h[valley] / smaller);
+        peak = valley = b;
+      } else if (h[b] >= h[peak]) {  // a higher peak without a deep valley between: same group
+        peak = valley = b;
+      }
+    }
+    std::vector<Moments> groups;
+    std::vector<double> cut_depth;  // between groups[k] and groups[k + 1]
+    int start = 0;
+    for (std::size_t c = 0; c <= cuts.size(); ++c) {
+      const int end = c < cuts.size() ? cuts[c] : kBins;
+      Moments m;
+      for (int b = start; b < end; ++b) m.add(bin[b]);
+      groups.push_back(m);
+      if (c < cuts.size()) cut_depth.push_back(depth[c]);
+      start = end;
+    }
+    auto merge = [&](std::size_t k) {  // groups k and k + 1
+      groups[k].add(groups[k + 1]);
+      groups.erase(groups.begin() + static_cast<long>(k) + 1);
+      cut_depth.erase(cut_depth.begin() + static_cast<long>(k));
+    };
+    for (bool changed = true; changed && groups.size() > 1;) {
+      changed = false;
+      for (std::size_t k = 0; k < groups.size() && groups.size() > 1; ++k) {
+        if (groups[k].w >= opt.mode_min_weight * all.w) continue;
+        if (k == 0) merge(0);
+        else if (k + 1 == groups.size()) merge(k - 1);
+        else merge(cut_depth[k - 1] > cut_depth[k] ? k - 1 : k);  // across the shallower cut
+        changed = true;
+        break;
+      }
+      for (std::size_t k = 0; !changed && k + 1 < groups.size(); ++k) {
+        if ((groups[k].mean() - groups[k + 1].mean()).norm() < opt.mode_min_separation_m) {
+          merge(k);
+          changed = true;
+        }
+      }
+    }
+    std::sort(groups.begin(), groups.end(), [](const Moments& a, const Moments& b) { return a.w > b.w; });
+    return groups;
+  }
+
+  Estimate compute_estimate() const {
     Estimate est;
     est.engine = EngineKind::kTerrain;
     est.t_ns = t_ns;
     if (!initialized) {
-      est.reason = "terrain: no start position";
+      est.reason = start_err.empty() ? "terrain: no start position" : start_err;
       return est;
     }
     double sw = 0.0, me = 0.0, mn = 0.0;
@@ -588,6 +818,23 @@ struct TerrainEngine::Impl {
     const DemSample ground = dem->at_local(me, mn);
     est.position.h_m = ground.valid() ? ground.elevation_m : 0.0;  // DEM datum (docs/terrain.md)
     est.vertical_sigma_m = std::sqrt(opt.measurement_var_m2);
+    const std::vector<Moments> groups = find_modes(est.en_m, est.cov_en_m2);
+    if (groups.empty()) {
+      TerrainMode m;
+      m.en_m = est.en_m;
+      m.cov_en_m2 = est.cov_en_m2;
+      m.weight = 1.0;
+      m.position = dem->to_geodetic(m.en_m.x(), m.en_m.y());
+      cache_modes.push_back(m);
+    }
+    for (const Moments& g : groups) {
+      TerrainMode m;
+      m.en_m = g.mean();
+      m.cov_en_m2 = g.cov();
+      m.weight = g.w / sw;
+      m.position = dem->to_geodetic(m.en_m.x(), m.en_m.y());
+      cache_modes.push_back(m);
+    }
     status_and_reason(est);
     return est;
   }
@@ -597,23 +844,43 @@ struct TerrainEngine::Impl {
     std::ostringstream os;
     os.precision(3);
     os << "terrain PF " << count << " particles";
+    if (cache_modes.size() > 1) {
+      est.status = EstimateStatus::kAmbiguous;
+      os << "; ambiguous: " << cache_modes.size() << " modes";
+      for (const TerrainMode& m : cache_modes) {
+        const ErrorEllipse el = ErrorEllipse::from_covariance(m.cov_en_m2);
+        os << ", " << std::lround(100.0 * m.weight) << "% at " << std::fixed << std::setprecision(6)
+           << m.position.lat_deg() << " " << m.position.lon_deg() << std::defaultfloat << std::setprecision(3)
+           << " (1-sigma " << el.semi_major_m << " x " << el.semi_minor_m << " m)";
+      }
+      os << "; the mean and ellipse span them";
+    }
+    if (stats.uninformative) {
+      est.status = est.status == EstimateStatus::kAmbiguous ? est.status : EstimateStatus::kDegraded;
+      os << "; terrain uninformative (relief " << stats.relief_m << " m under the cloud, below the "
+         << opt.uninformative_relief_sigmas * std::sqrt(opt.measurement_var_m2)
+         << " m noise): no terrain update, sigma growing as dead reckoning";
+    }
     if (!baro_usable) {
       est.status = EstimateStatus::kDegraded;
       os << "; start is off the DEM or on a void: no terrain updates (dead reckoning)";
     } else if (stats.updates == 0) {
       os << "; waiting for barometer";
     }
+    const auto degrade = [&] {
+      if (est.status != EstimateStatus::kAmbiguous) est.status = EstimateStatus::kDegraded;
+    };
     if (stats.off_dem_fraction > 0.5) {
-      est.status = EstimateStatus::kDegraded;
+      degrade();
       os << "; " << 100.0 * stats.off_dem_fraction << "% of the weight off the DEM or on voids";
     }
     if (stats.baro_stuck) {
-      est.status = EstimateStatus::kDegraded;
+      degrade();
       os << "; barometer stuck (one value for " << opt.baro_stuck_s << "+ s): terrain updates paused";
     }
     if (stats.baro_jumps > 0) os << "; " << stats.baro_jumps << " barometer step(s) compensated";
     if (recovering()) {
-      est.status = EstimateStatus::kDegraded;
+      degrade();
       os << "; recovering (" << alarm << ")";
     }
     est.reason = os.str();
@@ -631,7 +898,22 @@ void TerrainEngine::initialize(const geo::Geodetic& start, double sigma_m, TimeN
 }
 void TerrainEngine::feed(const PdrStep& step) { impl_->feed_step(step); }
 void TerrainEngine::feed(const PressureSample& p) { impl_->feed_pressure(p); }
-Estimate TerrainEngine::estimate() const { return impl_->estimate(); }
+Estimate TerrainEngine::estimate() const {
+  impl_->refresh();
+  return impl_->cache_est;
+}
+std::vector<TerrainMode> TerrainEngine::modes() const {
+  impl_->refresh();
+  return impl_->cache_modes;
+}
+std::string TerrainEngine::start_problem(const geo::Geodetic& start, double sigma_m) const {
+  return impl_->start_problem(start, sigma_m);
+}
+void TerrainEngine::check_start(const geo::Geodetic& start, double sigma_m) const {
+  const std::string why = impl_->start_problem(start, sigma_m);
+  if (!why.empty()) throw std::invalid_argument(why);
+}
+const std::string& TerrainEngine::start_error() const { return impl_->start_err; }
 const TerrainStats& TerrainEngine::stats() const { return impl_->stats; }
 const TerrainOptions& TerrainEngine::options() const { return impl_->opt; }
 const Dem& TerrainEngine::dem() const { return *impl_->dem; }
@@ -654,16 +936,16 @@ Eigen::Vector2d TerrainEngine::bias_estimate() const {
   for (std::size_t i = 0; i < impl_->count; ++i) {
     sw += impl_->w[i];
     sh += impl_->w[i] * impl_->p.bh[i];
-    sb += impl_->w[i] * impl_->p.bb[i];
+    sb += impl_->w[i] * (impl_->p.bb[i] + impl_->p.an[i]);
   }
   if (!(sw > 0.0)) return {0.0, 0.0};
   return {sh / sw, sb / sw};
 }
 
 std::size_t TerrainEngine::bytes_per_particle() {
-  // 6 floats (5 states + segment-start elevation) x 2 buffers + 1 float weight + 1 float
-  // residual + 1 double resampling scratch
-  return 2 * 6 * sizeof(float) + 2 * sizeof(float) + sizeof(double);
+  // 7 floats (5 states + segment-start elevation + start-anchor offset) x 2 buffers + 1 float
+  // weight + 1 float residual + 1 double resampling scratch
+  return 2 * 7 * sizeof(float) + 2 * sizeof(float) + sizeof(double);
 }
 
 }  // namespace pdnav::terrain

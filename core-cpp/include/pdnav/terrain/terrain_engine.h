@@ -76,6 +76,28 @@ struct TerrainOptions {
   /// Void / off-map particles: likelihood of a residual of this many sigmas (no information,
   /// a mild penalty), so voids neither kill nor attract particles.
   double no_info_sigmas = 2.0;
+  // --- honest status (beyond the paper; docs/terrain.md "Honest status") ---
+  /// A cloud whose weighted positions, projected on their major axis, split into several
+  /// groups separated by an empty-ish gap is reported as ambiguous with its modes. A gap is a
+  /// smoothed histogram valley below mode_valley_fraction of the smaller neighbouring peak;
+  /// each mode must hold at least mode_min_weight of the weight and the mode centres must be
+  /// mode_min_separation_m apart (closer modes are inside one honest ellipse anyway).
+  double mode_min_weight = 0.1;
+  double mode_valley_fraction = 0.25;
+  double mode_min_separation_m = 60.0;
+  /// Terrain is uninformative when the DEM relief (1-sigma of elevations sampled on two rings
+  /// around the cloud, radius max(informative_radius_m, 2 sigma of the cloud)) is below
+  /// uninformative_relief_sigmas x the measurement noise sqrt(R): a barometer then cannot tell
+  /// one particle from another, so the update is skipped (the cloud keeps growing with the
+  /// dead-reckoning noise, never locks on DEM noise) and the status says so. 0 = off.
+  double informative_radius_m = 150.0;
+  double uninformative_relief_sigmas = 1.0;
+  /// The start area (3 sigma around the declared start, per axis) must lie on the tile;
+  /// a wider start is refused (start_error()).
+  double start_coverage_sigmas = 3.0;
+  /// Start anchoring: each particle's baro bias starts at DEM(declared start) - DEM(its own
+  /// start), a constant of its hypothesis, instead of 0 for all (the paper). false = paper.
+  bool anchor_start_bias = true;
 
   /// Paper defaults (a 1-3 m lidar DEM).
   static TerrainOptions paper() { return {}; }
@@ -88,6 +110,14 @@ struct TerrainOptions {
   static TerrainOptions srtm_tuned();
   /// "paper", "srtm" or "srtm-tuned"; throws std::invalid_argument.
   static TerrainOptions preset(const std::string& name);
+};
+
+/// One mode of a multimodal particle cloud (DEM frame).
+struct TerrainMode {
+  Eigen::Vector2d en_m = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d cov_en_m2 = Eigen::Matrix2d::Zero();
+  double weight = 0.0;  // fraction of the total weight, 0..1
+  geo::Geodetic position;
 };
 
 /// Counters for diagnostics and tests.
@@ -107,6 +137,9 @@ struct TerrainStats {
   double baro_jump_offset_m = 0.0;       // sum of the compensated steps
   std::int64_t baro_stuck_events = 0;    // times the barometer was found stuck
   bool baro_stuck = false;               // stuck now: no terrain updates
+  std::int64_t uninformative_updates = 0;  // updates skipped: terrain relief below the noise
+  bool uninformative = false;            // at the last update
+  double relief_m = 0.0;                 // DEM relief (1-sigma) around the cloud, last update
 };
 
 class TerrainEngine {
@@ -118,18 +151,34 @@ class TerrainEngine {
 
   /// Spread particles around the declared start (sigma per axis) and anchor the barometer
   /// at the DEM elevation there: the next pressure sample becomes the reference pressure.
+  /// Each particle's baro bias starts at the DEM difference between the declared start and
+  /// its own start position (docs/terrain.md "Start anchoring"). A start whose
+  /// start_coverage_sigmas area reaches beyond the tile is refused: the engine stays without
+  /// a start, estimate() is invalid and says why, start_error() holds the message (never
+  /// throws: the Navigator feeds it from logs). check_start() is the throwing form.
   void initialize(const geo::Geodetic& start, double sigma_m, TimeNs t_ns);
+  /// Empty when initialize() would accept this start, else the reason it refuses it.
+  std::string start_problem(const geo::Geodetic& start, double sigma_m) const;
+  /// Throws std::invalid_argument with start_problem() when not empty.
+  void check_start(const geo::Geodetic& start, double sigma_m) const;
+  /// The reason the last initialize() was refused; empty when it was accepted.
+  const std::string& start_error() const;
   /// Propagation (Eq. 1-4), then a measurement update (Eq. 5-7) when baro is available,
   /// then resampling when Neff < threshold (Eq. 10).
   void feed(const PdrStep& step);
   /// Barometer: converted to altitude (geo::baro_altitude_m) and averaged until the next update.
   void feed(const PressureSample& p);
 
-  /// Weighted mean and covariance (Eq. 8-9), status and reason.
+  /// Weighted mean and covariance (Eq. 8-9), status and reason: kAmbiguous with the modes
+  /// in the reason when the cloud is multimodal (the mean and covariance then span them);
+  /// kDegraded "terrain uninformative" on featureless terrain. Cached until the next feed (the
+  /// cache makes concurrent calls on one engine unsafe; one engine belongs to one thread).
   Estimate estimate() const;
+  /// The modes of the cloud (one when unimodal; heaviest first; empty before the start).
+  std::vector<TerrainMode> modes() const;
   /// Up to max particles (evenly thinned), east/north in the DEM frame.
   std::vector<Eigen::Vector2d> particles_en(std::size_t max) const;
-  /// Weighted means of the bias states (heading bias rad, baro bias m).
+  /// Weighted means of the bias states (heading bias rad, baro bias m incl. the start anchor offset).
   Eigen::Vector2d bias_estimate() const;
   const TerrainStats& stats() const;
   const TerrainOptions& options() const;
