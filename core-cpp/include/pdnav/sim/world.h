@@ -68,7 +68,7 @@ std::vector<MagneticAnomaly> anomalies_along(const std::vector<Eigen::Vector2d>&
                                              const HeadingErrorOptions& o, Rng& rng);
 
 /// True step length of a walker: own stride, shorter on slopes (uphill more than downhill,
-/// Kawamura et al. 1991), shorter with fatigue, step-to-step variability (Hausdorff 2007).
+/// Kawamura et al. 1991), shorter with fatigue, step-to-step variability (Hausdorff 2005).
 struct StrideOptions {
   double stride_sd = 0.06;            // walker's stride vs the APT height model l = 0.415 h (per walk)
   double uphill_per_grade = 0.8;      // relative shortening per unit grade uphill (12 % -> -9.6 %)
