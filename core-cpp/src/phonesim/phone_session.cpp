@@ -216,7 +216,8 @@ PhoneSession simulate_session(const terrain::Dem& dem, const route::WalkGraph& g
   {
     std::vector<TimeNs> ok;  // the session must end inside the usable span
     for (const TimeNs h : hours)
-      if (std::find(hours.begin(), hours.end(), h + static_cast<TimeNs>(std::ceil(total_s / 3600.0)) * 3600 * kNsPerS) != hours.end())
+      // + 1 h: the start is up to 3000 s after the hour.
+      if (std::find(hours.begin(), hours.end(), h + static_cast<TimeNs>(std::ceil(total_s / 3600.0) + 1) * 3600 * kNsPerS) != hours.end())
         ok.push_back(h);
     const std::vector<TimeNs>& from = ok.empty() ? hours : ok;
     ses.gps_start_ns = from[std::uniform_int_distribution<std::size_t>(0, from.size() - 1)(rng)] +
