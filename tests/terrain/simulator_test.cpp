@@ -24,7 +24,9 @@ TEST(Simulator, ReproducibleAndRealistic) {
   EXPECT_LE(a.length_m, 5000.0 + 5.0);
   ASSERT_EQ(a.truth.size(), a.steps.size());
   const double duration_s = ns_to_s(a.steps.back().t_ns - a.t0_ns);
-  EXPECT_NEAR(static_cast<double>(a.steps.size()) / duration_s, 1.8, 0.1);
+  // World errors: the cadence (1.8 Hz on the flat) drops on grades (sim::Stride).
+  EXPECT_GT(static_cast<double>(a.steps.size()) / duration_s, 1.5);
+  EXPECT_LT(static_cast<double>(a.steps.size()) / duration_s, 1.85);
   EXPECT_NEAR(static_cast<double>(a.pressure.size()) / duration_s, 5.0, 0.1);
   // Truth stays on the tile, inside the margin.
   for (const Eigen::Vector2d& p : a.truth_en) {
@@ -32,7 +34,7 @@ TEST(Simulator, ReproducibleAndRealistic) {
     ASSERT_LT(p.y(), dem.max_n_m() - o.edge_margin_m + 1.0);
   }
   // Barometric altitude differences follow the truth heights within the error budget
-  // (FOGM bias 3 m, gusts, noise, temperature scale): first vs last sample.
+  // (weather trend <= 3 hPa / 3 h, tide, gusts, noise, temperature scale): first vs last sample.
   const double dh_baro = geo::baro_altitude_m(a.pressure.back().pressure_pa, a.pressure.front().pressure_pa, 0.0) -
                          geo::baro_altitude_m(a.pressure.front().pressure_pa, a.pressure.front().pressure_pa, 0.0);
   const double dh_true = a.truth.back().h_m - a.truth.front().h_m;
@@ -43,6 +45,30 @@ TEST(Simulator, ReproducibleAndRealistic) {
     max_err = std::max(max_err, std::abs(wrap_pi(a.steps[k].heading_rad - a.truth[k].heading_deg * kDegToRad)));
   EXPECT_GT(max_err, 5.0 * kDegToRad);
   EXPECT_LT(max_err, 120.0 * kDegToRad);
+}
+
+// The default errors are the world's, not the filter's: the PDR reports the model step while
+// the true stride varies (slope, fatigue, walker); world_errors = false gives the old models.
+TEST(Simulator, DefaultErrorsAreTheWorldModels) {
+  const Dem dem = test::synthetic_dem(301, 301, 30.0, test::hills);
+  WalkSimOptions o;
+  ASSERT_TRUE(o.world_errors);
+  const SimulatedWalk w = simulate_walk(dem, o, 5);
+  double min_true = 1e9, max_true = 0;
+  for (std::size_t k = 1; k < w.truth_en.size(); ++k) {
+    EXPECT_EQ(w.steps[k].length_m, o.step_length_mean_m);
+    const double l = (w.truth_en[k] - w.truth_en[k - 1]).norm();
+    if (l > 0.3) min_true = std::min(min_true, l), max_true = std::max(max_true, l);
+  }
+  EXPECT_GT(max_true - min_true, 0.1);  // slope, fatigue and step-to-step variability
+  for (const PressureSample& p : w.pressure) EXPECT_EQ(p.pressure_pa, std::round(p.pressure_pa));  // 1 Pa steps
+  o.world_errors = false;
+  const SimulatedWalk f = simulate_walk(dem, o, 5);
+  const double duration_s = ns_to_s(f.steps.back().t_ns - f.t0_ns);
+  EXPECT_NEAR(static_cast<double>(f.steps.size()) / duration_s, 1.8, 0.1);
+  bool varies = false;
+  for (const PdrStep& s : f.steps) varies = varies || s.length_m != o.step_length_mean_m;
+  EXPECT_TRUE(varies);
 }
 
 TEST(Simulator, TooSmallTileIsAClearError) {

@@ -148,7 +148,9 @@ std::uint64_t walk_seed(std::uint64_t base_seed, std::uint64_t k) {
   return detail::splitmix64(x);
 }
 
-SimulatedWalk simulate_walk(const Dem& dem, const WalkSimOptions& o, std::uint64_t seed) {
+namespace {
+
+SimulatedWalk simulate_walk_filter_models(const Dem& dem, const WalkSimOptions& o, std::uint64_t seed) {
   Rng rng(seed);
   SimulatedWalk w;
   w.seed = seed;
@@ -233,6 +235,97 @@ SimulatedWalk simulate_walk(const Dem& dem, const WalkSimOptions& o, std::uint64
     w.length_m += len;
   }
   return w;
+}
+
+/// The world error models (docs/simulator.md): nothing here is the filter's own model.
+SimulatedWalk simulate_walk_world(const Dem& dem, const WalkSimOptions& o, std::uint64_t seed) {
+  Rng rng(seed);
+  SimulatedWalk w;
+  w.seed = seed;
+  w.t0_ns = kNsPerS;
+  const double target = uniform(rng, o.min_length_m, o.max_length_m);
+  const std::vector<RoutePoint> route = make_route(dem, o, target, rng);
+  auto slope_deg = [&dem](double e, double n) {
+    const double d = 30.0;
+    const double gx = (dem.at_local(e + d, n).elevation_m - dem.at_local(e - d, n).elevation_m) / (2 * d);
+    const double gy = (dem.at_local(e, n + d).elevation_m - dem.at_local(e, n - d).elevation_m) / (2 * d);
+    return std::isfinite(gx) && std::isfinite(gy) ? std::atan(std::hypot(gx, gy)) * kRadToDeg : 0.0;
+  };
+  const sim::DemError dem_error(o.dem_world, dem.min_e_m(), dem.min_n_m(), dem.max_e_m(), dem.max_n_m(), slope_deg,
+                                [&dem](double e, double n) { return dem.at_local(e, n).elevation_m; }, rng);
+  const double expected_s = target / o.step_length_mean_m / o.step_rate_hz * 1.5 + 120.0;
+  const sim::BaroWorld baro(o.baro_world, expected_s, rng);
+  std::vector<Eigen::Vector2d> pts;
+  for (const RoutePoint& p : route) pts.emplace_back(p.e, p.n);
+  sim::HeadingError heading_err(o.heading_world, sim::anomalies_along(pts, o.anomalies_per_km, o.heading_world, rng), rng);
+  sim::StrideOptions so = o.stride_world;
+  so.cadence_min_hz = so.cadence_max_hz = o.step_rate_hz;  // the walk's cadence option still applies
+  so.cadence_cv = o.step_period_jitter;
+  const sim::Stride stride(so, o.step_length_mean_m, rng);
+
+  const Eigen::Vector2d start(route[0].e, route[0].n);
+  w.declared_start_en = start + Eigen::Vector2d(gauss(rng, o.start_sigma_m), gauss(rng, o.start_sigma_m));
+  w.declared_start = dem.to_geodetic(w.declared_start_en.x(), w.declared_start_en.y());
+  w.declared_sigma_m = o.start_sigma_m;
+  // DEM = true ground + error.
+  auto true_height = [&](double e, double n) { return dem.at_local(e, n).elevation_m - dem_error.error_m(e, n); };
+
+  double e = start.x(), n = start.y(), heading = route[0].heading, t_s = 0.0, t_baro = 0.0;
+  const double baro_dt = 1.0 / o.baro_rate_hz;
+  std::size_t leg = 1;
+  while (leg < route.size()) {
+    const double de = route[leg].e - e, dn = route[leg].n - n;
+    const double dist = std::hypot(de, dn);
+    if (dist < 1.0) {
+      ++leg;
+      continue;
+    }
+    const double turn = std::clamp(wrap_pi(std::atan2(de, dn) - heading), -30 * kDegToRad, 30 * kDegToRad);
+    heading = wrap_two_pi(heading + turn);
+    const double x_ahead = e + 2.0 * std::sin(heading), y_ahead = n + 2.0 * std::cos(heading);
+    double grade = (true_height(x_ahead, y_ahead) - true_height(e, n)) / 2.0;
+    if (!std::isfinite(grade)) grade = 0.0;
+    const double dt = stride.period_s(grade, rng);
+    const double len = std::min(dist, stride.length_m(t_s, grade, rng));
+    const double e_prev = e, n_prev = n;
+    e += len * std::sin(heading);
+    n += len * std::cos(heading);
+    const double t_prev = t_s;
+    t_s += dt;
+    while (t_baro + baro_dt <= t_s) {
+      t_baro += baro_dt;
+      const double f = (t_baro - t_prev) / dt;
+      PressureSample ps;
+      ps.t_ns = w.t0_ns + s_to_ns(t_baro);
+      ps.pressure_pa =
+          baro.pressure_pa(t_baro, true_height(e_prev + f * (e - e_prev), n_prev + f * (n - n_prev)) + o.phone_height_m, rng);
+      w.pressure.push_back(ps);
+    }
+    PdrStep step;
+    step.t_ns = w.t0_ns + s_to_ns(t_s);
+    step.length_m = o.step_length_mean_m;  // the PDR's model step: it does not know the walker
+    step.heading_rad = wrap_two_pi(heading + heading_err.advance(t_s, Eigen::Vector2d(e, n), rng));
+    step.heading_sigma_rad = o.heading_bias_sigma_rad;
+    step.length_sigma_m = o.length_noise_m;
+    w.steps.push_back(step);
+    const geo::Geodetic g = dem.to_geodetic(e, n);
+    TruthSample truth;
+    truth.t_ns = step.t_ns;
+    truth.lat_deg = g.lat_deg();
+    truth.lon_deg = g.lon_deg();
+    truth.h_m = true_height(e, n);
+    truth.heading_deg = rad_to_deg(heading);
+    w.truth.push_back(truth);
+    w.truth_en.emplace_back(e, n);
+    w.length_m += len;
+  }
+  return w;
+}
+
+}  // namespace
+
+SimulatedWalk simulate_walk(const Dem& dem, const WalkSimOptions& o, std::uint64_t seed) {
+  return o.world_errors ? simulate_walk_world(dem, o, seed) : simulate_walk_filter_models(dem, o, seed);
 }
 
 WalkEvaluation evaluate_walk(const SimulatedWalk& walk, std::shared_ptr<const Dem> dem,

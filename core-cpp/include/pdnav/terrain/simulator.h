@@ -1,6 +1,9 @@
 // Walk simulator on a real DEM: random routes with realistic PDR and barometer errors, and the
 // evaluation of the terrain engine against dead reckoning on such walks (pdnav simulate /
 // pdnav eval-terrain). Seeded and reproducible; no file I/O (the CLI writes the logs).
+// Errors: by default the world models of pdnav/sim/world.h (issue 17, docs/simulator.md),
+// which are not the filter's; world_errors = false restores the earlier filter-like models
+// (FOGM heading and baro bias, white DEM error) documented in docs/terrain.md.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -10,6 +13,7 @@
 
 #include "pdnav/geo/events.h"
 #include "pdnav/geo/samples.h"
+#include "pdnav/sim/world.h"
 #include "pdnav/terrain/dem.h"
 #include "pdnav/terrain/terrain_engine.h"
 
@@ -48,6 +52,19 @@ struct WalkSimOptions {
   double max_slope = 0.6;                     // route legs steeper than this are rejected
   double sea_level_pressure_pa = 101325.0;
   double temperature_offset_sd_k = 5.0;       // day's deviation from the ISA temperature
+  /// World error models (default): heading = random walk + phone shifts + magnetic anomalies
+  /// around structures; true stride varies with slope and fatigue while the PDR reports the
+  /// model's step_length_mean_m; barometer = weather trend + tide + gusts + offset + 1 Pa
+  /// quantisation; DEM error correlated, slope-dependent, canopy-biased. The fields above
+  /// that describe the old models (heading_bias_*, disturbance_*, baro_*, weather_*, gust_*,
+  /// dem_error_*, length_scale_error_sd, length_noise_m, step_length_jitter_m) are then unused.
+  bool world_errors = true;
+  sim::HeadingErrorOptions heading_world;
+  sim::StrideOptions stride_world;
+  sim::BaroWorldOptions baro_world;
+  sim::DemErrorOptions dem_world;
+  double anomalies_per_km = 3.0;              // magnetic structures along a mountain route
+  double phone_height_m = 1.3;                // barometer above the ground (chest)
 };
 
 /// A simulated walk: what a phone would log, plus the truth.
