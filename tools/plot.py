@@ -1,9 +1,11 @@
 #!/usr/bin/python3
 """pdnav plotting tool: figures a field tester wants from a replay output directory.
 
-  tools/plot.py replay OUT_DIR [--background RASTER] [--title T]
+  tools/plot.py replay OUT_DIR [--background RASTER|MBTILES] [--title T] [--out DIR]
       track.png  estimated track, reference track, 1-sigma ellipses (over hillshaded terrain
-                 when a GDAL-readable RASTER is given, e.g. /vsizip/N42E001.hgt.zip/N42E001.hgt)
+                 when a GDAL-readable RASTER is given, e.g. /vsizip/N42E001.hgt.zip/N42E001.hgt,
+                 or over the offline basemap when an .mbtiles from dem-tools/pdnav_basemap.py
+                 is given: paths, streets, water, contours at the highest zoom that covers it)
       error.png  horizontal error vs time with the predicted 1-sigma and 2-sigma radius
                  (the layout of Broyles et al. 2018, Figs. 8-10)
   tools/plot.py gnss CSV [--out DIR]
@@ -94,6 +96,76 @@ def hillshade_background(ax, raster, lat0, lon0, extent_en):
     ax.clabel(cs, fontsize=6, fmt="%d m")
 
 
+def mbtiles_background(ax, path, lat0, lon0, extent_en, max_px=2400):
+    """Draws the basemap tiles under the track: the highest zoom whose tiles cover the plot
+    extent in at most max_px a side. Web Mercator tiles are placed by their corners in the
+    local east/north plane (over a few km the map is linear in both to < 0.1 %)."""
+    import io
+    import sqlite3
+    try:
+        from PIL import Image
+    except ImportError:
+        print("plot: python3-pil missing, no basemap background", file=sys.stderr)
+        return
+    if not os.path.isfile(path):
+        raise SystemExit(f"plot: {path}: no such MBTiles file")
+    con = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+    try:
+        meta = dict(con.execute("SELECT name, value FROM metadata").fetchall())
+        zooms = sorted((r[0] for r in con.execute("SELECT DISTINCT zoom_level FROM tiles")), reverse=True)
+    except sqlite3.Error as err:
+        raise SystemExit(f"plot: {path}: not an MBTiles file: {err}")
+    e_min, e_max, n_min, n_max = extent_en
+    coslat = math.cos(math.radians(lat0))
+    lon_w = lon0 + math.degrees(e_min / (R_EARTH_M * coslat))
+    lon_e = lon0 + math.degrees(e_max / (R_EARTH_M * coslat))
+    lat_s = lat0 + math.degrees(n_min / R_EARTH_M)
+    lat_n = lat0 + math.degrees(n_max / R_EARTH_M)
+
+    def tile_xy(lon, lat, z):
+        n = 2 ** z
+        return ((lon + 180.0) / 360.0 * n,
+                (1.0 - math.asinh(math.tan(math.radians(lat))) / math.pi) / 2.0 * n)
+
+    def tile_lonlat(x, y, z):
+        n = 2 ** z
+        return x / n * 360.0 - 180.0, math.degrees(math.atan(math.sinh(math.pi * (1 - 2 * y / n))))
+
+    for z in zooms:
+        fx0, fy0 = tile_xy(lon_w, lat_n, z)
+        fx1, fy1 = tile_xy(lon_e, lat_s, z)
+        x0, x1, y0, y1 = int(fx0), int(fx1), int(fy0), int(fy1)
+        if (x1 - x0 + 1) * 256 > max_px or (y1 - y0 + 1) * 256 > max_px:
+            continue
+        need = [(x, y) for x in range(x0, x1 + 1) for y in range(y0, y1 + 1)]
+        got = {}
+        for x, y in need:
+            row = con.execute("SELECT tile_data FROM tiles WHERE zoom_level=? AND tile_column=? AND tile_row=?",
+                              (z, x, 2 ** z - 1 - y)).fetchone()
+            if row is None:
+                break
+            got[(x, y)] = row[0]
+        if len(got) < len(need):
+            continue  # this zoom does not cover the plot (area of interest only): go lower
+        img = Image.new("RGB", ((x1 - x0 + 1) * 256, (y1 - y0 + 1) * 256))
+        for (x, y), data in got.items():
+            img.paste(Image.open(io.BytesIO(data)).convert("RGB"), ((x - x0) * 256, (y - y0) * 256))
+        lw, ln = tile_lonlat(x0, y0, z)
+        le, ls = tile_lonlat(x1 + 1, y1 + 1, z)
+        ew, nn = local_en(ln, lw, lat0, lon0)
+        ee, ns = local_en(ls, le, lat0, lon0)
+        ax.imshow(np.asarray(img), extent=[ew, ee, ns, nn], origin="upper", zorder=0, interpolation="bilinear")
+        ax.text(0.995, 0.005, f"basemap z{z}: " + meta.get("attribution", ""), transform=ax.transAxes,
+                ha="right", va="bottom", fontsize=5.5, color="#333333",
+                bbox=dict(facecolor="white", alpha=0.7, lw=0, pad=1), zorder=10)
+        con.close()
+        print(f"plot: basemap {path} at zoom {z} ({len(got)} tiles)")
+        return
+    con.close()
+    print(f"plot: {path}: no zoom covers the track (lon {lon_w:.5f}..{lon_e:.5f}, lat {lat_s:.5f}..{lat_n:.5f})",
+          file=sys.stderr)
+
+
 def ellipse_xy(e, n, a, b, orient_deg, k=1.0, pts=48):
     t = np.linspace(0, 2 * math.pi, pts)
     u, v = k * a * np.cos(t), k * b * np.sin(t)
@@ -117,7 +189,9 @@ def plot_replay(args):
     all_n = np.concatenate([n, rn[np.isfinite(rn)]])
     pad = max(50.0, 0.1 * max(np.nanmax(all_e) - np.nanmin(all_e), np.nanmax(all_n) - np.nanmin(all_n)))
     extent = (np.nanmin(all_e) - pad, np.nanmax(all_e) + pad, np.nanmin(all_n) - pad, np.nanmax(all_n) + pad)
-    if args.background:
+    if args.background and args.background.endswith(".mbtiles"):
+        mbtiles_background(ax, args.background, lat0, lon0, extent)
+    elif args.background:
         hillshade_background(ax, args.background, lat0, lon0, extent)
     if np.isfinite(re_).any():
         ax.plot(re_, rn, "k-", lw=1.5, label="reference", zorder=3)
@@ -141,7 +215,9 @@ def plot_replay(args):
     ax.set_title(args.title or f"track: {os.path.basename(os.path.normpath(args.dir))}")
     ax.legend(loc="best", fontsize=8)
     fig.tight_layout()
-    out1 = os.path.join(args.dir, "track.png")
+    out_dir = args.out or args.dir
+    os.makedirs(out_dir, exist_ok=True)
+    out1 = os.path.join(out_dir, "track.png")
     fig.savefig(out1, dpi=110)
     plt.close(fig)
     written = [out1]
@@ -159,7 +235,7 @@ def plot_replay(args):
         ax.legend(fontsize=8)
         ax.set_title("error vs predicted uncertainty")
         fig.tight_layout()
-        out2 = os.path.join(args.dir, "error.png")
+        out2 = os.path.join(out_dir, "error.png")
         fig.savefig(out2, dpi=110)
         plt.close(fig)
         written.append(out2)
@@ -230,7 +306,9 @@ def main():
     sub = ap.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("replay", help="plots of a `pdnav replay` output directory")
     r.add_argument("dir")
-    r.add_argument("--background", help="GDAL raster for a hillshade background")
+    r.add_argument("--background", help="GDAL raster for a hillshade background, or an .mbtiles "
+                   "basemap (dem-tools/pdnav_basemap.py)")
+    r.add_argument("--out", help="folder for the PNGs (default: the replay folder)")
     r.add_argument("--title")
     g = sub.add_parser("gnss", help="plots of a `pdnav gnss --out CSV` file")
     g.add_argument("csv")

@@ -34,3 +34,13 @@ add_test(NAME apk_debug_assemble_verify
          COMMAND "${PROJECT_SOURCE_DIR}/tools/apk" --out "${PROJECT_BINARY_DIR}/apk"
                  --host-out "${_pdnav_android_out}")
 set_tests_properties(apk_debug_assemble_verify PROPERTIES LABELS "apk" TIMEOUT 900 RESOURCE_LOCK pdnav_maven)
+
+# ---- issue 21: pictures of every screen (begin) ----
+# ScreensRoboTest (run inside jvm_app_and_bridge, Robolectric native graphics) writes one PNG
+# per screen to ${_pdnav_android_out}/screens; this lists them and fails when one is missing.
+set_tests_properties(jvm_app_and_bridge PROPERTIES FIXTURES_SETUP pdnav_screens)
+add_test(NAME jvm_screen_pictures
+         COMMAND /usr/bin/python3 "${CMAKE_CURRENT_LIST_DIR}/check_screens.py" "${_pdnav_android_out}/screens"
+                 main-map permission-explanation sessions settings)
+set_tests_properties(jvm_screen_pictures PROPERTIES LABELS "jvm" FIXTURES_REQUIRED pdnav_screens)
+# ---- issue 21 (end) ----

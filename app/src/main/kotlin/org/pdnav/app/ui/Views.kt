@@ -2,6 +2,7 @@ package org.pdnav.app.ui
 
 import android.content.Context
 import android.os.Build
+import android.util.TypedValue
 import android.view.View
 import android.view.WindowInsets
 import android.widget.Button
@@ -16,6 +17,10 @@ internal object Views {
     fun button(ctx: Context, id: Int, text: CharSequence, onClick: () -> Unit) = Button(ctx).apply {
         this.id = id
         this.text = text
+        // one line: the map screen's four buttons share 360 dp on small phones, where the
+        // screen pictures (ScreensRoboTest) showed "NAVIGAT / E"; the text shrinks instead
+        maxLines = 1
+        if (Build.VERSION.SDK_INT >= 26) setAutoSizeTextTypeUniformWithConfiguration(9, 14, 1, TypedValue.COMPLEX_UNIT_SP)
         setOnClickListener { onClick() }
     }
 

@@ -1,0 +1,225 @@
+package org.pdnav.app.robo
+
+import android.Manifest
+import android.content.Context
+import android.content.pm.PackageManager
+import android.graphics.Bitmap
+import android.graphics.Point
+import android.graphics.Rect
+import android.os.Looper
+import android.view.View
+import org.junit.Test
+import org.junit.runner.RunWith
+import org.osmdroid.util.GeoPoint
+import org.osmdroid.views.MapView
+import org.osmdroid.views.overlay.Marker
+import org.osmdroid.views.overlay.Overlay
+import org.osmdroid.views.overlay.Polygon
+import org.osmdroid.views.overlay.Polyline
+import org.pdnav.app.R
+import org.pdnav.app.map.MapController
+import org.pdnav.app.nav.NavOutput
+import org.pdnav.app.recording.ReplayTask
+import org.pdnav.app.recording.SessionStore
+import org.pdnav.app.ui.AppSettings
+import org.pdnav.app.ui.MainActivity
+import org.pdnav.app.ui.SessionsActivity
+import org.pdnav.app.ui.SettingsActivity
+import org.robolectric.Robolectric
+import org.robolectric.RobolectricTestRunner
+import org.robolectric.RuntimeEnvironment
+import org.robolectric.Shadows.shadowOf
+import org.robolectric.annotation.Config
+import org.robolectric.annotation.GraphicsMode
+import org.robolectric.annotation.LooperMode
+import kotlin.math.abs
+import kotlin.math.hypot
+import kotlin.test.assertEquals
+import kotlin.test.assertNotNull
+import kotlin.test.assertNull
+import kotlin.test.assertTrue
+
+/**
+ * Pictures of every screen the app has, drawn by Robolectric's native graphics (real Skia,
+ * real fonts) into PNGs under the build folder (system property pdnav.screens), each with
+ * checks on the picture itself: where the estimate projects the marker's pixels are, the error
+ * ellipse and the track are drawn where their points project, the basemap tiles (dem-tools,
+ * Mapnik) are drawn under them, and no text is ellipsized, cut off or missing its glyphs.
+ * Screens that do not exist yet (satellite view) get their picture when they exist.
+ */
+@RunWith(RobolectricTestRunner::class)
+@LooperMode(LooperMode.Mode.PAUSED)
+@GraphicsMode(GraphicsMode.Mode.NATIVE)
+@Config(qualifiers = "w360dp-h640dp-xhdpi")
+class ScreensRoboTest {
+    private val app = RuntimeEnvironment.getApplication()
+
+    private fun idle() = shadowOf(Looper.getMainLooper()).idle()
+
+    private fun grantAll() = shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION,
+        Manifest.permission.ACCESS_COARSE_LOCATION, Manifest.permission.ACTIVITY_RECOGNITION)
+
+    /** Pixels of [a] and [b] (same size) that differ, inside [r]. */
+    private fun diff(a: Bitmap, b: Bitmap, r: Rect): List<Point> {
+        val out = ArrayList<Point>()
+        for (y in r.top until r.bottom) for (x in r.left until r.right) {
+            if (a.getPixel(x, y) != b.getPixel(x, y)) out += Point(x, y)
+        }
+        return out
+    }
+
+    private fun bbox(ps: List<Point>): Rect {
+        val r = Rect(Int.MAX_VALUE, Int.MAX_VALUE, Int.MIN_VALUE, Int.MIN_VALUE)
+        for (p in ps) r.union(p.x, p.y)
+        return r
+    }
+
+    /** The picture with the overlays of one kind hidden (then shown again). */
+    private fun without(decor: View, map: MapView, kind: (Overlay) -> Boolean): Bitmap {
+        val hidden = map.overlays.filter { kind(it) && it.isEnabled }
+        hidden.forEach { it.isEnabled = false }
+        val bmp = BasemapFixture.snapshot(decor)
+        hidden.forEach { it.isEnabled = true }
+        return bmp
+    }
+
+    @Test
+    fun mainMapWithAReplayedSession() {
+        grantAll()
+        val (dem, log) = BasemapFixture.simulatedWalk()
+        val basemap = BasemapFixture.mbtiles()
+        val settings = AppSettings(app.getSharedPreferences(AppSettings.PREFS, Context.MODE_PRIVATE))
+        settings.basemapPath = basemap.path
+        settings.demPath = dem.path
+        settings.engine = "terrain"
+        // replay the simulated session through the native navigator, as the in-app replay does
+        val outs = ArrayList<NavOutput>()
+        var failure: Exception? = null
+        ReplayTask(log.path, settings.navigatorConfig(), 1L, onProgress = { o, _ -> outs += o },
+            onDone = { o, e -> if (o != null) outs += o; failure = e }).run()
+        assertNull(failure, "replay failed")
+        val valid = outs.filter { it.estimate.valid && !it.estimate.latDeg.isNaN() }
+        assertTrue(valid.size > 20, "replay gave ${valid.size} valid estimates")
+        val track = valid.map { doubleArrayOf(it.estimate.latDeg, it.estimate.lonDeg) }
+        val last = valid.last()
+
+        val activity = Robolectric.buildActivity(MainActivity::class.java).setup().get()
+        activity.showOutput(last, track)
+        val mapView = activity.findViewById<MapView>(R.id.map_view)
+        val decor = activity.window.decorView
+        // let osmdroid's tile threads read the MBTiles and the main looper hand the tiles over
+        var pic = BasemapFixture.snapshot(decor)
+        val mapLoc = IntArray(2).also { mapView.getLocationInWindow(it) }
+        val mapRect = Rect(mapLoc[0], mapLoc[1], mapLoc[0] + mapView.width, mapLoc[1] + mapView.height)
+        fun basemapPixels(b: Bitmap): Int {
+            var n = 0
+            for (y in mapRect.top until mapRect.bottom step 4) for (x in mapRect.left until mapRect.right step 4) {
+                val c = b.getPixel(x, y)
+                // osmdroid's "loading" grid is neutral grey; the basemap is tinted (land cover,
+                // hillshade, water, paths)
+                val r = android.graphics.Color.red(c)
+                val g = android.graphics.Color.green(c)
+                val bl = android.graphics.Color.blue(c)
+                if (maxOf(abs(r - g), abs(g - bl), abs(r - bl)) >= 8) n++
+            }
+            return n
+        }
+        val end = System.currentTimeMillis() + 30_000
+        while (System.currentTimeMillis() < end) {
+            idle()
+            Thread.sleep(100)
+            pic = BasemapFixture.snapshot(decor)
+            if (basemapPixels(pic) > (mapRect.width() / 4) * (mapRect.height() / 4) * 3 / 4) break
+        }
+        BasemapFixture.save(pic, "main-map")
+
+        // basemap tiles under the overlays (osmdroid's tile pipeline on the host)
+        val cells = (mapRect.width() / 4) * (mapRect.height() / 4)
+        assertTrue(basemapPixels(pic) > cells * 3 / 4, "basemap drawn on ${basemapPixels(pic)} of $cells sampled pixels")
+
+        val proj = mapView.projection
+        fun px(lat: Double, lon: Double): Point {
+            val p = proj.toPixels(GeoPoint(lat, lon), null)
+            return Point(p.x + mapLoc[0], p.y + mapLoc[1])
+        }
+        val e = last.estimate
+        val here = px(e.latDeg, e.lonDeg)
+        assertTrue(mapRect.contains(here.x, here.y), "estimate projects off the map at $here")
+
+        // marker: its pixels are centred where the estimate projects
+        val markerDiff = diff(pic, without(decor, mapView) { it is Marker }, mapRect)
+        assertTrue(markerDiff.size >= 100, "marker: ${markerDiff.size} pixels")
+        val mb = bbox(markerDiff)
+        assertTrue(abs(mb.centerX() - here.x) <= 4 && abs(mb.centerY() - here.y) <= 4,
+            "marker drawn at ${mb.centerX()},${mb.centerY()}, estimate projects to $here")
+
+        // 95 % ellipse: its drawn extent is the projected extent of its own points
+        val ellipseDiff = diff(pic, without(decor, mapView) { it is Polygon }, mapRect)
+        val expected = bbox(MapController.ellipsePoints(e).map { px(it.latitude, it.longitude) })
+        assertTrue(expected.width() >= 6, "ellipse too small to see: $expected")
+        expected.intersect(mapRect)
+        val eb = bbox(ellipseDiff)
+        for ((got, want) in listOf(eb.left to expected.left, eb.right to expected.right, eb.top to expected.top,
+                                   eb.bottom to expected.bottom)) {
+            assertTrue(abs(got - want) <= 4, "ellipse drawn over $eb, its points project over $expected")
+        }
+
+        // track: drawn along its projected vertices
+        val trackDiff = diff(pic, without(decor, mapView) { it is Polyline }, mapRect)
+        assertTrue(trackDiff.isNotEmpty(), "track not drawn")
+        val onScreen = track.map { px(it[0], it[1]) }.filter { mapRect.contains(it.x, it.y) }
+        assertTrue(onScreen.size >= 5, "track hardly on screen (${onScreen.size} points)")
+        val near = onScreen.count { v -> trackDiff.any { hypot((it.x - v.x).toDouble(), (it.y - v.y).toDouble()) <= 4.0 } }
+        // vertices under the marker or the ellipse outline are hidden by them
+        assertTrue(near >= onScreen.size * 6 / 10, "track drawn near $near of ${onScreen.size} vertices")
+
+        // status line: engine and reason, not clipped
+        val status = activity.findViewById<android.widget.TextView>(R.id.status_text)
+        assertTrue(status.text.contains("terrain"), "status: ${status.text}")
+        BasemapFixture.assertTextNotClipped(decor, pic, "main map")
+    }
+
+    @Test
+    fun permissionExplanation() {
+        val activity = Robolectric.buildActivity(MainActivity::class.java).setup().get()
+        val request = assertNotNull(shadowOf(activity).lastRequestedPermission)
+        activity.onRequestPermissionsResult(request.requestCode, request.requestedPermissions,
+            IntArray(request.requestedPermissions.size) { PackageManager.PERMISSION_DENIED })
+        idle()
+        val decor = activity.window.decorView
+        val pic = BasemapFixture.snapshot(decor)
+        BasemapFixture.save(pic, "permission-explanation")
+        val panel = activity.findViewById<View>(R.id.permission_panel)
+        assertEquals(View.VISIBLE, panel.visibility)
+        BasemapFixture.assertTextNotClipped(panel, pic.let {
+            val loc = IntArray(2).also { panel.getLocationInWindow(it) }
+            Bitmap.createBitmap(it, loc[0], loc[1], panel.width, panel.height)
+        }, "permission explanation")
+    }
+
+    @Test
+    fun sessionsList() {
+        val store = SessionStore(app)
+        store.newSessionFile(1_780_300_000_000L).writeText("# walk 1\n")
+        store.newSessionFile(1_780_310_000_000L).writeText("# walk 2\n")
+        store.newSessionFile(1_780_320_000_000L).writeText("# walk 3\n")
+        val activity = Robolectric.buildActivity(SessionsActivity::class.java).setup().get()
+        idle()
+        val decor = activity.window.decorView
+        val pic = BasemapFixture.snapshot(decor)
+        BasemapFixture.save(pic, "sessions")
+        val list = activity.findViewById<android.widget.ListView>(R.id.sessions_list)
+        assertEquals(3, list.childCount, "rows drawn")
+        BasemapFixture.assertTextNotClipped(decor, pic, "sessions")
+    }
+
+    @Test
+    fun settings() {
+        val activity = Robolectric.buildActivity(SettingsActivity::class.java).setup().get()
+        idle()
+        val decor = activity.window.decorView
+        val pic = BasemapFixture.snapshot(decor)
+        BasemapFixture.save(pic, "settings")
+        BasemapFixture.assertTextNotClipped(decor, pic, "settings")
+    }
+}
