@@ -107,8 +107,11 @@ struct Navigator::Impl {
 
   static pdr::PdrOptions pdr_options(const NavigatorConfig& c) {
     pdr::PdrOptions o;
-    o.length = length_model(std::isfinite(c.user_height_m) ? c.user_height_m : kDefaultUserHeightM, c.user_female);
+    // height known: APT's height model; unknown: a model that adapts to the walker (docs/pdr.md)
+    o.length = std::isfinite(c.user_height_m) ? length_model(c.user_height_m, c.user_female)
+                                              : pdr::StepLengthModel::unknown_walker();
     o.source = pdr::StepSource::kAuto;  // Android step events while they arrive, else APT detector
+    o.heading.mount = c.mount;
     return o;
   }
 

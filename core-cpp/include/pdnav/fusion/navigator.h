@@ -10,6 +10,7 @@
 
 #include "pdnav/geo/estimate.h"
 #include "pdnav/geo/samples.h"
+#include "pdnav/pdr/heading.h"
 
 namespace pdnav::terrain { class Dem; }
 namespace pdnav::route { class WalkGraph; }
@@ -35,6 +36,9 @@ struct NavigatorConfig {
   /// before the first step, else kDefaultUserHeightM.
   double user_height_m = kNaN;
   bool user_female = false;
+  /// Phone placement: kAuto estimates placement and walking direction from the motion
+  /// (docs/pdr.md); a declared mount overrides it.
+  pdr::Mount mount = pdr::Mount::kAuto;
   std::string dem_path;                   // project DEM tile (dem-tools), empty = no terrain engine
   std::string graph_path;                 // project walkway graph (dem-tools), empty = no route engine
   std::vector<std::string> nav_paths;     // RINEX navigation files for the GNSS engine
