@@ -42,6 +42,7 @@ struct EvalPdrArgs {
   double height_m = kNaN;
   bool quiet = false;
   bool legacy = false;
+  bool no_declination = false;  // diagnostic (--via pdr): magnetic headings, no WMM tests
   double tau_s = kNaN;          // heading fusion offset memory (with --via pdr)
   double field_tolerance = kNaN;
   double disturbed_weight = kNaN;
@@ -91,6 +92,7 @@ struct WalkResult {
   std::vector<double> errors_m, naive_errors_m, seg_heading_err_deg;
   double mean_m = kNaN, naive_mean_m = kNaN, length_ratio = kNaN, naive_ratio = kNaN;
   std::int64_t steps = 0;
+  double declination_deg = kNaN;
 };
 
 double median(std::vector<double> v) {
@@ -144,7 +146,8 @@ pdr::PdrOptions pdr_options_for(const EvalPdrArgs& a) {
 /// Position source: the Navigator (dr) or a directly integrated Pdr.
 class Runner {
  public:
-  explicit Runner(const EvalPdrArgs& a) : via_nav_(a.via == "navigator" && !a.legacy) {
+  explicit Runner(const EvalPdrArgs& a) : via_nav_(a.via == "navigator" && !a.legacy), wmm_(!a.no_declination) {
+    if (a.no_declination && a.via == "navigator") throw std::invalid_argument("--no-declination needs --via pdr");
     if (a.via != "navigator" && a.via != "pdr") throw std::invalid_argument("--via: expected navigator or pdr");
     if (via_nav_) {
       fusion::NavigatorConfig c;
@@ -188,10 +191,10 @@ class Runner {
     last_en_ = en_;
     path_m_ = 0;
     if (nav_) nav_->set_start(g.lat_deg(), g.lon_deg(), 1.0, t_ns);
-    if (pdr_) pdr_->set_location(g, kMissingInt);
+    if (pdr_ && wmm_) pdr_->set_location(g, kMissingInt);
   }
   void set_location(const geo::Geodetic& g, std::int64_t utc_ms) {
-    if (pdr_) pdr_->set_location(g, utc_ms);
+    if (pdr_ && wmm_) pdr_->set_location(g, utc_ms);
   }
   /// Current east/north in the evaluation frame; accumulates the path length of the navigator.
   std::optional<Eigen::Vector2d> position() {
@@ -211,6 +214,7 @@ class Runner {
 
  private:
   bool via_nav_;
+  bool wmm_;
   std::unique_ptr<fusion::Navigator> nav_;
   std::unique_ptr<pdr::Pdr> pdr_;
   geo::LocalFrame frame_;
@@ -228,7 +232,7 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   NaivePdr naive;
   geo::LocalFrame frame;
   bool started = false;
-  double declination = 0.0;
+  const double declination = 0.0;  // naive: magnetic heading (see below)
   std::int64_t first_utc = kMissingInt;
   std::vector<Eigen::Vector2d> truth_en, est_en;
   double naive_path_m = 0;
@@ -245,10 +249,10 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
         run.start(g, t->t_ns, frame);
         naive.start(Eigen::Vector2d::Zero());
         started = true;
-        if (first_utc != kMissingInt) {
-          declination = geo::magnetic_declination_rad(g, first_utc);
-          run.set_location(g, first_utc);
-        }
+        // the naive PDR keeps the raw (magnetic) rotation-vector yaw, as the issue's naive
+        // reference does; ours gets the WMM declination like the Navigator
+        if (first_utc != kMissingInt) run.set_location(g, first_utc);
+        r.declination_deg = geo::magnetic_declination_rad(g, first_utc) / kDegToRad;
         truth_en.push_back(Eigen::Vector2d::Zero());
         est_en.push_back(Eigen::Vector2d::Zero());
         continue;
@@ -318,10 +322,10 @@ int run_eval_pdr(const EvalPdrArgs& a) {
       continue;
     }
     const WalkResult& r = all.back();
-    std::printf("%-48s wps %2zu steps %4lld mean_err_m %6.2f max %6.2f ratio %5.3f | naive %6.2f ratio %5.3f\n",
+    std::printf("%-48s wps %2zu steps %4lld mean_err_m %6.2f max %6.2f ratio %5.3f seg_heading_median %+5.1f | naive %6.2f ratio %5.3f\n",
                 r.name.c_str(), r.errors_m.size() + 1, static_cast<long long>(r.steps), r.mean_m,
-                *std::max_element(r.errors_m.begin(), r.errors_m.end()), r.length_ratio, r.naive_mean_m,
-                r.naive_ratio);
+                *std::max_element(r.errors_m.begin(), r.errors_m.end()), r.length_ratio,
+                median(r.seg_heading_err_deg), r.naive_mean_m, r.naive_ratio);
     if (!a.quiet) {
       std::printf("    waypoint_errors_m: %s\n", join(r.errors_m, 2).c_str());
       std::printf("    segment_heading_error_deg: %s\n", join(r.seg_heading_err_deg, 1).c_str());
@@ -341,8 +345,8 @@ int run_eval_pdr(const EvalPdrArgs& a) {
   for (double h : herr) abs_herr.push_back(std::abs(h));
   std::printf("walks %zu (failed %d); better than naive in %d; naive median_mean_error_m %.2f\n", all.size(), failed, wins,
               median(naive_means));
-  std::printf("segment heading error: median signed %.1f deg, median |.| %.1f deg over %zu segments\n", median(herr),
-              median(abs_herr), herr.size());
+  std::printf("segment heading error: median signed %.1f deg, median |.| %.1f deg over %zu segments; WMM declination %.1f deg\n",
+              median(herr), median(abs_herr), herr.size(), all.front().declination_deg);
   std::printf("median_mean_error_m: %.2f median_length_ratio: %.3f\n", median(means), median(ratios));
   return failed ? 1 : 0;
 }
@@ -364,6 +368,8 @@ void register_eval_pdr(CLI::App& app) {
   c->add_option("--tau", a->tau_s, "with --via pdr: heading-fusion offset memory, s");
   c->add_option("--field-tolerance", a->field_tolerance, "with --via pdr: |B| tolerance vs WMM (fraction)");
   c->add_option("--disturbed-weight", a->disturbed_weight, "with --via pdr: weight of a disturbed reading");
+  c->add_flag("--no-declination", a->no_declination,
+              "diagnostic, with --via pdr: no WMM (magnetic headings, no field tests)");
   c->add_flag("--quiet", a->quiet, "one line per walk");
   c->add_flag("--legacy", a->legacy,
               "the engine as before issue 16 (chest mount, latest rotation vector, APT 1.75 m, no motion gate)");

@@ -248,3 +248,30 @@ TEST(PdrStepLength, FrequencyModelAndLearnedScale) {
   p.set_length_model(StepLengthModel::apt_male(1.8));  // a new model keeps the learned scale
   EXPECT_DOUBLE_EQ(p.length_scale(), 0.85);
 }
+
+TEST(PdrMotion, AndroidStepEventsWhileWavingAreRefused) {
+  // a phone's own step detector that counts the waving (1.6 Hz events) must not make steps
+  const RealWalk walk = read_ilc(pdnav::test::shared_data(kWalk));
+  const TimeNs start = walk.accel.front().t_ns;
+  const RealWalk waving = make_waving(walk, start, 30.0, 7, 1.0);
+  PdrOptions o;
+  o.heading.mount = Mount::kAuto;
+  o.source = StepSource::kAuto;
+  for (bool gate : {true, false}) {
+    o.gate_handling = gate;
+    Pdr p(o);
+    std::size_t ig = 0, counted = 0;
+    TimeNs next_event = waving.accel.front().t_ns + 2'000'000'000;
+    for (const auto& s : waving.accel) {
+      while (ig < waving.gyro.size() && waving.gyro[ig].t_ns <= s.t_ns) p.feed(waving.gyro[ig++]);
+      p.feed(s);
+      if (s.t_ns >= next_event) {
+        p.feed(StepDetectorSample{s.t_ns, kMissingInt});
+        next_event += 625'000'000;
+      }
+      counted += p.take_steps().size();
+    }
+    if (gate) EXPECT_LE(counted, 2u);
+    else EXPECT_GT(counted, 30u);  // the events are there: only the gate removes them
+  }
+}

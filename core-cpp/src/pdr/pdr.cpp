@@ -69,6 +69,8 @@ void Pdr::feed(const AccelSample& s) {
     gate_.end_bout();
     return;
   }
+  last_swing_mps2_ = candidate->swing_mps2;
+  last_swing_ns_ = candidate->t_ns;
   for (const auto& c : gate_.push(candidate->t_ns, *candidate)) {
     accel_step_times_.push_back(c.t_ns);
     const bool use = opt_.source == StepSource::kAccelerometer ||
@@ -131,8 +133,14 @@ void Pdr::feed(const StepDetectorSample& s) {
   android_step_times_.push_back(s.t_ns);
   have_android_ = true;
   last_android_ns_ = s.t_ns;
+  if (opt_.gate_handling && (classifier_.state() == MotionState::kHandling || classifier_.handling_at(s.t_ns))) {
+    ++counters_.steps_discarded_by_motion;  // the phone's own detector counts waving too
+    return;
+  }
   if (opt_.source == StepSource::kAndroid || opt_.source == StepSource::kAuto) {
-    emit_step(s.t_ns, kNaN, kNaN);
+    // the swing of the accelerometer's own latest step (within 2 s), else the model's fallback
+    const bool fresh = last_swing_ns_ >= 0 && std::abs(ns_to_s(s.t_ns - last_swing_ns_)) <= 2.0;
+    emit_step(s.t_ns, fresh ? last_swing_mps2_ : kNaN, kNaN);
   }
   trim_consistency(s.t_ns);
 }

@@ -134,6 +134,9 @@ class Pdr {
   Eigen::Vector3d last_field_ut_ = Eigen::Vector3d::Zero();
   TimeNs last_gyro_ns_ = -1;
   double distance_m_ = 0.0;
+  // the latest accelerometer step's swing, lent to Android step events (Weinberg needs one)
+  double last_swing_mps2_ = kNaN;
+  TimeNs last_swing_ns_ = -1;
   std::int64_t gaps_seen_ = 0;
   PdrCounters counters_;
   // heading state: time of the last absolute heading (fusion_ holds the offset)
