@@ -67,7 +67,8 @@ int run_replay(const ReplayArgs& a) {
   twin_opt.heading.mount = config.mount;
   twin_opt.source = pdr::StepSource::kAuto;
   twin_opt.length = std::isfinite(config.user_height_m) ? pdr::StepLengthModel::apt_male(config.user_height_m)
-                                                        : pdr::StepLengthModel::unknown_walker();
+                    : config.mount == pdr::Mount::kAuto ? pdr::StepLengthModel::unknown_walker()
+                                                        : pdr::StepLengthModel::apt_male(fusion::kDefaultUserHeightM);
   pdr::Pdr twin(twin_opt);
   TimeNs t0_ns = -1;
   ReplayRecorder rec;

@@ -107,9 +107,11 @@ struct Navigator::Impl {
 
   static pdr::PdrOptions pdr_options(const NavigatorConfig& c) {
     pdr::PdrOptions o;
-    // height known: APT's height model; unknown: a model that adapts to the walker (docs/pdr.md)
-    o.length = std::isfinite(c.user_height_m) ? length_model(c.user_height_m, c.user_female)
-                                              : pdr::StepLengthModel::unknown_walker();
+    // height known: APT's height model; unknown with nothing declared (mount auto): a model
+    // that adapts to the walker (docs/pdr.md); else APT with the default height
+    o.length = std::isfinite(c.user_height_m)       ? length_model(c.user_height_m, c.user_female)
+               : c.mount == pdr::Mount::kAuto ? pdr::StepLengthModel::unknown_walker()
+                                              : length_model(kDefaultUserHeightM, c.user_female);
     o.source = pdr::StepSource::kAuto;  // Android step events while they arrive, else APT detector
     o.heading.mount = c.mount;
     return o;

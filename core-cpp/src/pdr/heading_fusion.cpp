@@ -46,6 +46,7 @@ void HeadingFusion::add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, dou
     const double dt_s = ns_to_s(t_ns - last_ns_);
     const double decay = std::exp(-dt_s / (gyro_live ? opt_.tau_s : opt_.no_gyro_tau_s));
     all_.shift_and_decay(dt_s, decay);
+    circ_ *= decay;
     trusted_.shift_and_decay(dt_s, decay);
     weight_s_ = weight_s_ * decay + weight * std::min(1.0, dt_s);
   }
@@ -55,6 +56,8 @@ void HeadingFusion::add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, dou
   const double pred = all_.s0 > 0.0 ? (all_.y0 - drift_radps() * all_.s1) / all_.s0 : 0.0;
   const double y = pred + wrap_pi(c - anchor_rad_ - pred);
   all_.add(weight, y);
+  circ_ += weight * Eigen::Vector2d(std::cos(c), std::sin(c));
+  last_c_rad_ = c;
   if (weight >= 1.0) trusted_.add(weight, y);
   weight_ = all_.s0;
   (weight >= 1.0 ? accepted_ : disturbed_) += 1;
@@ -74,10 +77,12 @@ void HeadingFusion::reset() {
   all_ = LineSums{};
   trusted_ = LineSums{};
   weight_ = weight_s_ = 0.0;
+  circ_.setZero();
   have_last_ = false;
 }
 
 double HeadingFusion::heading_mag_rad(double yaw_rad, TimeNs t_ns) const {
+  if (all_.s0 > 0.0 && circ_.norm() / all_.s0 < opt_.min_consistency) return wrap_two_pi(last_c_rad_ - yaw_rad);
   const double b = drift_radps();
   const double a = all_.s0 > 0.0 ? (all_.y0 - b * all_.s1) / all_.s0 : 0.0;
   const double since = have_last_ ? std::max(0.0, ns_to_s(t_ns - last_ns_)) : 0.0;

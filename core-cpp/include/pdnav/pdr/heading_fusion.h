@@ -32,6 +32,11 @@ struct HeadingFusionOptions {
   double min_sigma_rad = 3 * kDegToRad;
   double max_drift_radps = 1.0 * kDegToRad;  // |estimated gyro yaw drift| at most (MEMS: < 0.5 deg/s)
   double drift_prior_s = 5.0;             // ridge on the drift: time spread needed to trust it
+  // Consistency: mean resultant length of the offsets (1 = all agree). Below this the gyro and
+  // the absolute readings contradict each other (e.g. a heading that flips 180 deg while the
+  // gyro is still): the offset is unknown, the latest reading is followed (the pre-fusion
+  // behaviour) until they agree again.
+  double min_consistency = 0.5;
 };
 
 class HeadingFusion {
@@ -68,6 +73,8 @@ class HeadingFusion {
   LineSums all_;      // every reading: the offset
   LineSums trusted_;  // readings that passed the tests only: the drift (a disturbance is not a slope)
   double weight_ = 0.0;                            // decayed sum of w (= all_.s0)
+  Eigen::Vector2d circ_ = Eigen::Vector2d::Zero();  // decayed sum of w (cos c, sin c)
+  double last_c_rad_ = 0.0;                         // the latest reading's offset
   double weight_s_ = 0.0;                          // decayed sum of w dt (information, seconds)
   bool have_last_ = false;
   TimeNs last_ns_ = 0;

@@ -39,7 +39,7 @@ struct PlacementOptions {
   double change_hold_s = 1.5;          // ... for this long: a new placement bout
   double phase_lag_s = 0.14;           // a quarter of a 0.55 s step (1.8 Hz cadence)
   double flip_corr = -0.25;            // flat/upright prior reversed only below this correlation
-  double min_bout_s = 4.0;             // correlation trusted after this much walking in a bout
+  double min_bout_s = 2.0;             // correlation trusted after this much walking in a bout
 };
 
 /// A placement bout: from t_start_ns to t_end_ns (last sample so far for the open one).
