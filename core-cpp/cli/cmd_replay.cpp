@@ -14,6 +14,7 @@
 
 #include "pdnav/fusion/navigator.h"
 #include "pdnav/io/log_reader.h"
+#include "pdnav/pdr/pdr.h"
 #include "support/replay_support.h"
 
 namespace pdnav::cli {
@@ -31,6 +32,7 @@ struct ReplayArgs {
   std::string preset = "srtm-tuned";
   std::uint64_t seed = 1;
   double height_m = std::numeric_limits<double>::quiet_NaN();  // NaN: the log's, else 1.75 m
+  std::string mount = "auto";
   bool quiet = false;
 };
 
@@ -43,6 +45,7 @@ fusion::NavigatorConfig make_config(const ReplayArgs& a) {
   c.particles = a.particles;
   c.terrain_preset = a.preset;
   c.user_height_m = a.height_m;
+  c.mount = pdr::mount_from_string(a.mount);
   if (!a.start.empty()) {
     const std::vector<double> v = parse_number_list(a.start, "--start");
     if (v.size() < 2 || v.size() > 3) throw std::invalid_argument("--start wants LAT,LON[,SIGMA_M]");
@@ -85,13 +88,35 @@ int run_replay(const ReplayArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   std::filesystem::create_directories(a.out_dir);
   io::LogReader reader(a.log);
-  fusion::Navigator nav(make_config(a), a.seed);
+  const fusion::NavigatorConfig config = make_config(a);
+  fusion::Navigator nav(config, a.seed);
+  // A PDR twin with the Navigator's placement options, for the summary's placements/distance.
+  pdr::PdrOptions twin_opt;
+  twin_opt.heading.mount = config.mount;
+  twin_opt.source = pdr::StepSource::kAuto;
+  twin_opt.length = std::isfinite(config.user_height_m) ? pdr::StepLengthModel::apt_male(config.user_height_m)
+                    : config.mount == pdr::Mount::kAuto ? pdr::StepLengthModel::unknown_walker()
+                                                        : pdr::StepLengthModel::apt_male(fusion::kDefaultUserHeightM);
+  pdr::Pdr twin(twin_opt);
+  TimeNs t0_ns = -1;
   ReplayRecorder rec;
   ProgressBar progress(a.quiet ? nullptr : &std::cerr, "replay");
   Sample s;
   while (reader.next(s)) {
     rec.observe_reference(s);
     nav.feed(s);
+    std::visit(
+        [&](const auto& x) {
+          using T = std::decay_t<decltype(x)>;
+          if constexpr (std::is_same_v<T, AccelSample> || std::is_same_v<T, GyroSample> || std::is_same_v<T, MagSample> ||
+                        std::is_same_v<T, RotationVectorSample> || std::is_same_v<T, StepDetectorSample>) {
+            if (t0_ns < 0) t0_ns = x.t_ns;
+            twin.feed(x);
+            (void)twin.take_steps();
+            (void)twin.take_turns();
+          }
+        },
+        s);
     rec.observe_estimate(nav.estimate());
     progress.update(reader.progress());
   }
@@ -124,6 +149,7 @@ int run_replay(const ReplayArgs& a) {
   if (st.n > 0) summary["errors"] = st.to_json();
   summary["reference"] = rec.reference_kind();
   summary["fusion"] = fusion_summary(nav);
+  summary["pdr"] = pdr_summary_json(twin, nav.output(0).steps, std::max<TimeNs>(0, t0_ns));
   std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
 
   std::cout << "log:      " << a.log << "\n"
@@ -162,6 +188,8 @@ void register_replay(CLI::App& app) {
   c->add_option("--terrain-preset", a->preset, "paper | srtm | srtm-tuned")->capture_default_str();
   c->add_option("--height", a->height_m,
                  "user height in metres for the step length (default: the log's Meta UserHeightMeters, else 1.75)");
+  c->add_option("--mount", a->mount, "phone placement: auto (estimated from the motion) | chest | hand | ...")
+      ->capture_default_str();
   c->add_option("--seed", a->seed, "random seed")->capture_default_str();
   c->add_flag("--quiet", a->quiet, "no progress bar");
   c->callback([a]() {

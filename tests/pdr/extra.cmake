@@ -44,3 +44,23 @@ add_test(NAME steps_cli_eval_terrain_hgt_zip
          COMMAND sh -c "out=$(\"$0\" eval-terrain --dem \"$1\" --walks 1 2>&1); rc=$?; echo \"rc=$rc $out\"; [ $rc -ne 0 ] && echo \"$out\" | grep -qF \"dem-tools/pdnav_dem.py tile /vsizip/$1/N42E001.hgt -o N42E001.pdem --center 42.5 1.5 --radius 36000\""
                  $<TARGET_FILE:pdnav> "${PDNAV_SHARED_DATA_DIR}/terrain-andorra/N42E001.hgt.zip")
 set_tests_properties(steps_cli_eval_terrain_hgt_zip PROPERTIES LABELS "terrain;cli")
+# Issue 16: three real ILC walks converted by tools/ilc2log, then scored by pdnav eval-pdr
+# (the whole set: docs/pdr.md). The converter must georeference the waypoints (Truth lines)
+# and the evaluation must print its summary line.
+set(_pdr_ilc "${PDNAV_SHARED_DATA_DIR}/pdr-ilc2020/data")
+set(_pdr_ilc_out "${PROJECT_BINARY_DIR}/test-scratch/pdr-ilc")
+add_test(NAME pdr_cli_ilc_convert
+         COMMAND /usr/bin/python3 "${PROJECT_SOURCE_DIR}/tools/ilc2log" --out "${_pdr_ilc_out}"
+                 "${_pdr_ilc}/site2/F3/path_data_files/5dd38fff44333f00067aa387.txt"
+                 "${_pdr_ilc}/site2/F3/path_data_files/5dd398c544333f00067aa431.txt"
+                 "${_pdr_ilc}/site1/F4/path_data_files/5ddb656fc5b77e0006b1792e.txt")
+set_tests_properties(pdr_cli_ilc_convert PROPERTIES LABELS "pdr;cli" FIXTURES_SETUP pdr_ilc
+                     PASS_REGULAR_EXPRESSION "converted 3 of 3 walks")
+add_test(NAME pdr_cli_eval_pdr
+         COMMAND pdnav eval-pdr --quiet
+                 "${_pdr_ilc_out}/site2_F3_5dd38fff44333f00067aa387.log"
+                 "${_pdr_ilc_out}/site2_F3_5dd398c544333f00067aa431.log"
+                 "${_pdr_ilc_out}/site1_F4_5ddb656fc5b77e0006b1792e.log")
+# all three walks within 6 m mean error (they are 2.4-5 m today; the legacy engine: > 10 m)
+set_tests_properties(pdr_cli_eval_pdr PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_ilc
+                     PASS_REGULAR_EXPRESSION "walks 3 \\(failed 0\\).*median_mean_error_m: [0-5]\\.[0-9]+ median_length_ratio: [01]\\.[0-9]+\n")

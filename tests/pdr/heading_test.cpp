@@ -159,8 +159,10 @@ TEST(PdrHeading, StepsCarryTrueNorthHeadingFromRotationVectorAndWmm) {
   ASSERT_GT(steps.size(), 40u);
   EXPECT_NEAR(static_cast<double>(steps.size()), 30.0 * spec.cadence_hz, 3.0);
   for (const auto& s : steps) {
-    // sway is +-3 deg about the walking direction (north = 0 in the RV frame)
-    EXPECT_NEAR(rad_to_deg(wrap_pi(s.heading_rad - decl)), 0.0, 4.0);
+    // sway is +-3 deg about the walking direction (north = 0 in the RV frame); the heading is
+    // gyro-dominant (issue 16: the rotation vector only corrects the gyro's offset), so the
+    // synthetic gyro bias (~0.4 deg/s per axis) adds up to ~1 deg while its drift is learned
+    EXPECT_NEAR(rad_to_deg(wrap_pi(s.heading_rad - decl)), 0.0, 5.0);
     EXPECT_NEAR(s.length_m, 0.415 * 1.75, 1e-9);
     EXPECT_GT(s.heading_sigma_rad, 0.0);
   }

@@ -251,3 +251,29 @@ void ReplayRecorder::write_geojson(const std::string& path, std::size_t max_elli
 }
 
 }  // namespace pdnav::cli
+
+namespace pdnav::cli {
+
+nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_steps, TimeNs t0_ns) {
+  nlohmann::json j;
+  j["steps"] = navigator_steps;
+  j["distance_m"] = pdr.distance_m();
+  j["mount"] = pdr::to_string(pdr.options().heading.mount);
+  const pdr::PdrCounters c = pdr.counters();
+  j["steps_refused_handling"] = c.steps_discarded_by_motion;
+  j["steps_dropped_by_bout_gate"] = c.steps_discarded_by_bout_gate;
+  j["magnetometer_readings_trusted"] = c.mag_readings_trusted;
+  j["magnetometer_readings_disturbed"] = c.mag_readings_disturbed;
+  nlohmann::json bouts = nlohmann::json::array();
+  for (const pdr::PlacementBout& b : pdr.placements()) {
+    bouts.push_back({{"placement", pdr::to_string(b.placement)},
+                     {"start_s", ns_to_s(b.t_start_ns - t0_ns)},
+                     {"end_s", ns_to_s(b.t_end_ns - t0_ns)},
+                     {"forward_phone", {b.forward_phone.x(), b.forward_phone.y(), b.forward_phone.z()}},
+                     {"phase_corr", b.phase_corr}});
+  }
+  j["placements"] = bouts;
+  return j;
+}
+
+}  // namespace pdnav::cli

@@ -12,6 +12,7 @@
 #include "pdnav/geo/estimate.h"
 #include "pdnav/geo/frames.h"
 #include "pdnav/geo/samples.h"
+#include "pdnav/pdr/pdr.h"
 
 namespace pdnav::cli {
 
@@ -83,6 +84,11 @@ class ReplayRecorder {
   TimeNs last_t_ = -1;
   EstimateStatus last_status_ = EstimateStatus::kNotInitialized;
 };
+
+/// The PDR part of replay's summary.json: steps (the Navigator's count), distance walked (sum
+/// of step lengths), placement bouts with their time spans (s from the first sample) and
+/// walking direction in phone axes, steps refused by the motion classifier.
+nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_steps, TimeNs t0_ns);
 
 /// Ellipse outline (lon, lat) polygon for an estimate at probability scale k (1 = 1-sigma).
 std::vector<std::pair<double, double>> ellipse_polygon(const Estimate& e, double k, int points = 36);

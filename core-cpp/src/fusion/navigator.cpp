@@ -182,8 +182,13 @@ struct Navigator::Impl {
 
   static pdr::PdrOptions pdr_options(const NavigatorConfig& c) {
     pdr::PdrOptions o;
-    o.length = length_model(std::isfinite(c.user_height_m) ? c.user_height_m : kDefaultUserHeightM, c.user_female);
+    // height known: APT's height model; unknown with nothing declared (mount auto): a model
+    // that adapts to the walker (docs/pdr.md); else APT with the default height
+    o.length = std::isfinite(c.user_height_m)       ? length_model(c.user_height_m, c.user_female)
+               : c.mount == pdr::Mount::kAuto ? pdr::StepLengthModel::unknown_walker()
+                                              : length_model(kDefaultUserHeightM, c.user_female);
     o.source = pdr::StepSource::kAuto;  // Android step events while they arrive, else APT detector
+    o.heading.mount = c.mount;
     return o;
   }
 

@@ -2,6 +2,7 @@
 #include "pdnav/pdr/heading.h"
 
 #include <cmath>
+#include <stdexcept>
 
 #include <Eigen/Geometry>
 
@@ -12,11 +13,30 @@ Eigen::Vector3d forward_axis(Mount mount) {
     case Mount::kChestScreenOut:
       return Eigen::Vector3d::UnitZ();
     case Mount::kHandheld:
+    case Mount::kAuto:
       return Eigen::Vector3d::UnitY();
     case Mount::kChestCameraOut:
     default:
       return -Eigen::Vector3d::UnitZ();
   }
+}
+
+Mount mount_from_string(const std::string& s) {
+  if (s == "auto") return Mount::kAuto;
+  if (s == "chest" || s == "chest-camera-out") return Mount::kChestCameraOut;
+  if (s == "chest-screen-out") return Mount::kChestScreenOut;
+  if (s == "hand" || s == "handheld") return Mount::kHandheld;
+  throw std::invalid_argument("mount '" + s + "': expected auto, chest, chest-camera-out, chest-screen-out, hand, handheld");
+}
+
+const char* to_string(Mount m) {
+  switch (m) {
+    case Mount::kAuto: return "auto";
+    case Mount::kChestCameraOut: return "chest-camera-out";
+    case Mount::kChestScreenOut: return "chest-screen-out";
+    case Mount::kHandheld: return "handheld";
+  }
+  return "unknown";
 }
 
 namespace {

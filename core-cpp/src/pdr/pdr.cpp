@@ -14,7 +14,10 @@ Pdr::Pdr(const PdrOptions& options)
       detector_(options.detector),
       gate_(options.detector.bout_min_steps, options.detector.max_step_interval_s,
             options.detector.short_walk_min_steps),
-      tracker_(options.heading.turn) {}
+      tracker_(options.heading.turn),
+      classifier_(options.motion),
+      placement_(options.placement),
+      fusion_(options.fusion) {}
 
 void Pdr::set_location(const geo::Geodetic& where, std::int64_t utc_ms) {
   const geo::Declination d = geo::declination_at(where, utc_ms);
@@ -22,10 +25,41 @@ void Pdr::set_location(const geo::Geodetic& where, std::int64_t utc_ms) {
   declination_ = d;
   declination_rad_ = d.declination_rad;
   has_location_ = true;
+  // expected field for the magnitude/dip tests (WMM2025, date clamped to its validity)
+  const geo::WmmModel& model = geo::WmmModel::wmm2025();
+  const double year = utc_ms == kMissingInt ? model.epoch_year
+                                            : std::clamp(geo::decimal_year_from_unix_ms(utc_ms), model.epoch_year,
+                                                         model.epoch_year + 5.0);
+  const geo::MagneticField f = geo::wmm_field(model, where, year);
+  fusion_.set_reference_field(f.f_nt * 1e-3, f.inclination_rad);
+}
+
+Eigen::Vector3d Pdr::reference_axis() const {
+  return opt_.heading.mount == Mount::kAuto ? placement_.reference_phone() : forward_axis(opt_.heading.mount);
+}
+
+void Pdr::sync_placement() {
+  if (placement_.revision() == placement_revision_) return;
+  placement_revision_ = placement_.revision();
+  // a new placement bout: the reference axis may have changed, restart the offset (auto only)
+  if (opt_.heading.mount == Mount::kAuto) fusion_.reset();
+}
+
+void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight) {
+  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s &&
+                         tracker_.has_gravity();
+  fusion_.add(t_ns, heading_mag_rad, tracker_.yaw_rad(), weight, gyro_live);
+  have_heading_ = true;
+  ref_t_ns_ = t_ns;
 }
 
 void Pdr::feed(const AccelSample& s) {
   tracker_.feed(s);
+  classifier_.feed(s);
+  const bool handling = opt_.gate_handling && classifier_.state() == MotionState::kHandling;
+  if (handling) placement_.end_bout();  // the phone is being moved: re-estimate afterwards
+  else placement_.feed(s, gate_.in_bout());
+  sync_placement();
   const auto candidates = detector_.feed(s);
   if (detector_.counters().gaps != gaps_seen_) {  // a gap resets the detector and the bout
     gaps_seen_ = detector_.counters().gaps;
@@ -33,19 +67,28 @@ void Pdr::feed(const AccelSample& s) {
   }
   latest_ns_ = std::max(latest_ns_, s.t_ns);
   release(gate_.expire(s.t_ns), s.t_ns);
-  for (const auto& c : candidates) release(gate_.push(c.t_ns, hold(c.t_ns, c.swing_mps2)), s.t_ns);
+  for (const auto& c : candidates) {
+    if (opt_.gate_handling && (handling || classifier_.handling_at(c.t_ns))) {
+      // a waved/handled phone: no step, and the bout must start again after it
+      ++counters_.steps_discarded_by_motion;
+      (void)gate_.end_bout();
+      continue;
+    }
+    last_swing_mps2_ = c.swing_mps2;
+    last_swing_ns_ = c.t_ns;
+    release(gate_.push(c.t_ns, hold(c)), s.t_ns);
+  }
   trim_consistency(s.t_ns);
 }
 
-Pdr::HeldStep Pdr::hold(TimeNs t_ns, double swing_mps2) const {
+Pdr::HeldStep Pdr::hold(const StepCandidate& c) const {
   HeldStep h;
-  h.candidate.t_ns = t_ns;
-  h.candidate.swing_mps2 = swing_mps2;
+  h.candidate = c;
   // The heading at the step's own time (issue 20.2): magnetic when referenced to the rotation
   // vector or compass (declination added when the step is taken), true when gyro-only from
-  // the configured initial heading.
-  h.magnetic = have_heading_;
-  h.heading_rad = wrap_two_pi(heading_rad() - (have_heading_ ? declination_rad_ : 0.0));
+  // the configured initial heading (heading_rad() adds the declination only in the first case).
+  h.magnetic = fusion_.valid();
+  h.heading_rad = wrap_two_pi(heading_rad() - (h.magnetic ? declination_rad_ : 0.0));
   h.heading_sigma_rad = heading_sigma_rad();
   return h;
 }
@@ -63,6 +106,8 @@ void Pdr::finish() { release(gate_.finish(), latest_ns_); }
 
 void Pdr::feed(const GyroSample& s) {
   tracker_.feed(s);
+  classifier_.feed(s);
+  if (s.rate_radps.allFinite() && s.t_ns >= last_gyro_ns_) last_gyro_ns_ = s.t_ns;
   latest_ns_ = std::max(latest_ns_, s.t_ns);
 }
 
@@ -70,30 +115,16 @@ void Pdr::feed(const MagSample& s) {
   const SampleCheck c = check_sample(s.t_ns, s.field_ut.allFinite(), mag_last_ns_, have_mag_last_,
                                      opt_.heading.turn.gap_reset_s, counters_.mag);
   if (c == SampleCheck::kNonFinite || c == SampleCheck::kDuplicate || c == SampleCheck::kBackwards) return;
-  const double dt_s = (have_mag_last_ && c != SampleCheck::kGap) ? ns_to_s(s.t_ns - mag_last_ns_) : 0.0;
   have_mag_last_ = true;
   mag_last_ns_ = s.t_ns;
+  last_field_ut_ = s.field_ut;
   latest_ns_ = std::max(latest_ns_, s.t_ns);
   if (!tracker_.has_gravity()) return;
   if (have_rv_ && ns_to_s(s.t_ns - last_rv_ns_) <= opt_.heading.rv_max_age_s) return;  // RV wins
-  const auto compass = compass_heading_rad(s.field_ut, tracker_.up_phone(), forward_axis(opt_.heading.mount),
-                                           opt_.heading.min_horizontal);
+  const auto compass =
+      compass_heading_rad(s.field_ut, tracker_.up_phone(), reference_axis(), opt_.heading.min_horizontal);
   if (!compass) return;
-  const double yaw = tracker_.yaw_rad();
-  if (!have_heading_ || ref_from_rv_) {
-    ref_heading_mag_rad_ = *compass;
-    ref_sigma_rad_ = opt_.heading.compass_sigma_rad;
-  } else {
-    // Complementary filter: gyro-propagated heading pulled toward the compass.
-    const double current = ref_heading_mag_rad_ - (yaw - ref_yaw_rad_);
-    const double alpha = dt_s / (opt_.heading.compass_tau_s + dt_s);
-    ref_heading_mag_rad_ = current + alpha * wrap_pi(*compass - current);
-    ref_sigma_rad_ = std::min(heading_sigma_rad(), opt_.heading.compass_sigma_rad);
-  }
-  ref_yaw_rad_ = yaw;
-  ref_t_ns_ = s.t_ns;
-  ref_from_rv_ = false;
-  have_heading_ = true;
+  absolute_heading(s.t_ns, *compass, fusion_.field_weight(s.field_ut, tracker_.up_phone()));
 }
 
 void Pdr::feed(const RotationVectorSample& s) {
@@ -102,19 +133,19 @@ void Pdr::feed(const RotationVectorSample& s) {
   if (c == SampleCheck::kNonFinite || c == SampleCheck::kDuplicate || c == SampleCheck::kBackwards) return;
   last_rv_check_ns_ = s.t_ns;
   latest_ns_ = std::max(latest_ns_, s.t_ns);
-  const auto h = rotation_vector_heading_rad(s.quat_xyzw, forward_axis(opt_.heading.mount),
-                                             opt_.heading.min_horizontal);
+  const auto h = rotation_vector_heading_rad(s.quat_xyzw, reference_axis(), opt_.heading.min_horizontal);
   have_rv_ = true;
-  if (!h) return;  // forward axis near vertical: keep propagating with the gyro
+  if (!h) return;  // reference axis near vertical: keep propagating with the gyro
   last_rv_ns_ = s.t_ns;
-  ref_heading_mag_rad_ = *h;
-  ref_yaw_rad_ = tracker_.yaw_rad();
-  ref_sigma_rad_ = (std::isfinite(s.heading_accuracy_rad) && s.heading_accuracy_rad > 0.0)
-                       ? s.heading_accuracy_rad
-                       : opt_.heading.rv_sigma_rad;
-  ref_t_ns_ = s.t_ns;
-  ref_from_rv_ = true;
-  have_heading_ = true;
+  // The rotation vector is the phone's own gyro+magnetometer fusion: it is as disturbed as
+  // the field it used, so it is weighted by the latest magnetometer reading's tests.
+  const bool mag_fresh = have_mag_last_ && ns_to_s(s.t_ns - mag_last_ns_) <= opt_.heading.rv_max_age_s;
+  double w = mag_fresh && tracker_.has_gravity() ? fusion_.field_weight(last_field_ut_, tracker_.up_phone()) : 1.0;
+  // the sensor's own heading accuracy (when it reports one): inverse-variance relative to one
+  // nominal reading, never above it
+  if (std::isfinite(s.heading_accuracy_rad) && s.heading_accuracy_rad > 0.0)
+    w *= std::clamp(std::pow(opt_.fusion.base_sigma_rad / s.heading_accuracy_rad, 2), opt_.fusion.disturbed_weight, 1.0);
+  absolute_heading(s.t_ns, *h, w);
 }
 
 void Pdr::feed(const StepDetectorSample& s) {
@@ -126,8 +157,18 @@ void Pdr::feed(const StepDetectorSample& s) {
   android_step_times_.push_back(s.t_ns);
   have_android_ = true;
   last_android_ns_ = s.t_ns;
+  if (opt_.gate_handling && (classifier_.state() == MotionState::kHandling || classifier_.handling_at(s.t_ns))) {
+    ++counters_.steps_discarded_by_motion;  // the phone's own detector counts waving too
+    return;
+  }
   if (opt_.source == StepSource::kAndroid || opt_.source == StepSource::kAuto) {
-    emit_step(hold(s.t_ns, kNaN));
+    // the swing of the accelerometer's own latest step (within 2 s), else the model's fallback
+    const bool fresh = last_swing_ns_ >= 0 && std::abs(ns_to_s(s.t_ns - last_swing_ns_)) <= 2.0;
+    StepCandidate c;
+    c.t_ns = s.t_ns;
+    c.swing_mps2 = fresh ? last_swing_mps2_ : kNaN;
+    c.interval_s = 0.0;  // unknown: the length model's cadence fallback
+    emit_step(hold(c));
   }
   trim_consistency(s.t_ns);
 }
@@ -138,23 +179,26 @@ bool Pdr::android_active(TimeNs t_ns) const {
 
 double Pdr::heading_rad() const {
   const double yaw = tracker_.yaw_rad();
-  if (!have_heading_) return wrap_two_pi(opt_.heading.initial_heading_rad - yaw);
-  return wrap_two_pi(ref_heading_mag_rad_ - (yaw - ref_yaw_rad_) + declination_rad_);
+  const double offset = opt_.heading.mount == Mount::kAuto ? placement_.forward_offset_rad() : 0.0;
+  if (!fusion_.valid()) return wrap_two_pi(opt_.heading.initial_heading_rad - yaw + offset);
+  return wrap_two_pi(fusion_.heading_mag_rad(yaw, latest_ns_) + offset + declination_rad_);
 }
 
 double Pdr::heading_sigma_rad() const {
   const TimeNs since = have_heading_ ? latest_ns_ - ref_t_ns_ : latest_ns_;
-  const double base = have_heading_ ? ref_sigma_rad_ : opt_.heading.initial_sigma_rad;
+  const double base = fusion_.valid() ? fusion_.sigma_rad() : opt_.heading.initial_sigma_rad;
   return std::min(kPi, base + opt_.heading.gyro_drift_radps * std::max(0.0, ns_to_s(since)));
 }
 
 void Pdr::emit_step(const HeldStep& h) {
   PdrStep st;
   st.t_ns = h.candidate.t_ns;
-  st.length_m = opt_.length.length_m(h.candidate.swing_mps2);
+  const double interval_s = h.candidate.interval_s;
+  st.length_m = opt_.length.length_m(h.candidate.swing_mps2, interval_s > 0.0 ? 1.0 / interval_s : kNaN);
   st.length_sigma_m = opt_.length.sigma_m(st.length_m);
   st.heading_rad = h.heading_rad;
   st.heading_sigma_rad = h.heading_sigma_rad;
+  distance_m_ += st.length_m;
   steps_.push_back(st);
   steps_magnetic_.push_back(h.magnetic ? 1 : 0);
   ++step_count_;
@@ -195,6 +239,8 @@ PdrCounters Pdr::counters() const {
   c.accel = detector_.counters();
   c.gyro = tracker_.gyro_counters();
   c.steps_discarded_by_bout_gate = gate_.discarded();
+  c.mag_readings_trusted = fusion_.accepted();
+  c.mag_readings_disturbed = fusion_.disturbed();
   return c;
 }
 

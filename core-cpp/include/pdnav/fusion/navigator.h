@@ -14,6 +14,7 @@
 #include "pdnav/fusion/pdr_calibrator.h"
 #include "pdnav/geo/estimate.h"
 #include "pdnav/geo/samples.h"
+#include "pdnav/pdr/heading.h"
 
 namespace pdnav::terrain { class Dem; }
 namespace pdnav::route { class WalkGraph; }
@@ -86,9 +87,14 @@ struct NavigatorConfig {
   double start_lon_deg = kNaN;
   double start_sigma_m = 5.0;             // Broyles et al. 2018: 5 m initial uncertainty
   /// User height for the APT step length; NaN = the log's Meta UserHeightMeters when it comes
-  /// before the first step, else kDefaultUserHeightM.
+  /// before the first step, else (mount kAuto) the unknown-walker model
+  /// (pdr::StepLengthModel::unknown_walker) or (declared mount) kDefaultUserHeightM.
   double user_height_m = kNaN;
   bool user_female = false;
+  /// Phone placement: kAuto estimates placement and walking direction from the motion and,
+  /// with the height unknown, uses the unknown-walker step length (docs/pdr.md); a declared
+  /// mount overrides both (the default keeps the app's chest mount; `pdnav replay` uses auto).
+  pdr::Mount mount = pdr::Mount::kChestCameraOut;
   std::string dem_path;                   // project DEM tile (dem-tools), empty = no terrain engine
   std::string graph_path;                 // project walkway graph (dem-tools), empty = no route engine
   std::vector<std::string> nav_paths;     // RINEX navigation files for the GNSS engine

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <deque>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -20,12 +21,18 @@ namespace pdnav::pdr {
 /// Where the phone is carried: which phone axis points in the walking direction.
 /// Android axes: +X right, +Y top of the screen, +Z out of the screen.
 enum class Mount {
+  kAuto,            // estimated from the motion (placement + walking direction, docs/pdr.md)
   kChestCameraOut,  // chest, top up, camera (back) facing forward: forward = -Z
   kChestScreenOut,  // chest, top up, screen facing forward: forward = +Z
   kHandheld,        // held in front, screen up, top ahead: forward = +Y
 };
-/// The phone-frame unit vector that points where the user walks for a mount.
+/// The phone-frame unit vector that points where the user walks for a mount (kAuto: +Y, the
+/// reference axis the estimated walking-direction offset is measured from).
 Eigen::Vector3d forward_axis(Mount mount);
+/// "auto", "chest" (= chest-camera-out), "chest-camera-out", "chest-screen-out", "hand" /
+/// "handheld"; throws std::invalid_argument naming the accepted values otherwise.
+Mount mount_from_string(const std::string& s);
+const char* to_string(Mount m);
 
 /// APT Sec. V-B parameters for the gyro re-orientation and turn reports.
 struct TurnOptions {

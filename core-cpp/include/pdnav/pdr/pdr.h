@@ -1,6 +1,7 @@
 // The PDR engine face: raw inertial samples in, steps (time, length, true-north heading,
 // sigmas) and turns out. Deterministic (no random component, so no seed).
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <deque>
 #include <optional>
@@ -11,6 +12,9 @@
 #include "pdnav/geo/samples.h"
 #include "pdnav/geo/wmm.h"
 #include "pdnav/pdr/heading.h"
+#include "pdnav/pdr/heading_fusion.h"
+#include "pdnav/pdr/motion_classifier.h"
+#include "pdnav/pdr/placement.h"
 #include "pdnav/pdr/step_detector.h"
 #include "pdnav/pdr/step_length.h"
 
@@ -26,7 +30,11 @@ enum class StepSource {
 struct PdrOptions {
   StepDetectorOptions detector;  // APT Sec. V-A (+ gates)
   StepLengthModel length;        // APT Sec. V-A: l = c1 * height
-  HeadingOptions heading;        // rotation vector + WMM, or APT Sec. V-B gyro re-orientation
+  HeadingOptions heading;        // mount; APT Sec. V-B gyro re-orientation; fallbacks
+  HeadingFusionOptions fusion;   // gyro-dominant heading, magnetic readings gated against WMM
+  PlacementOptions placement;    // placement + walking direction when heading.mount == kAuto
+  MotionClassifierOptions motion;  // walking / standing / handling
+  bool gate_handling = true;     // no steps while the phone is handled or waved
   StepSource source = StepSource::kAccelerometer;
   double android_timeout_s = 3.0;
   /// Consistency check: the two step sources agree when their counts differ by at most this
@@ -43,6 +51,9 @@ struct PdrCounters {
   SampleCounters rotation_vector;
   SampleCounters step_detector;
   std::int64_t steps_discarded_by_bout_gate = 0;
+  std::int64_t steps_discarded_by_motion = 0;  // candidates while the phone was handled/waved
+  std::int64_t mag_readings_trusted = 0;       // absolute headings that passed the WMM tests
+  std::int64_t mag_readings_disturbed = 0;     // ... and that failed them (down-weighted)
   std::int64_t total_skipped() const {
     return accel.skipped() + gyro.skipped() + mag.skipped() + rotation_vector.skipped() + step_detector.skipped();
   }
@@ -69,7 +80,20 @@ class Pdr {
   void set_location(const geo::Geodetic& where, std::int64_t utc_ms);
   /// Replace the step-length model (e.g. the user's height read from a recorded session);
   /// applies to the steps detected from now on.
-  void set_length_model(const StepLengthModel& model) { opt_.length = model; }
+  void set_length_model(const StepLengthModel& model) {
+    const double keep = opt_.length.scale;
+    opt_.length = model;
+    opt_.length.scale = keep;
+  }
+  /// The walker's step-length scale (multiplies whatever model is in use; 1 = as published).
+  /// Fusion learns it online from GNSS or the map; applies from the next step. Non-finite or
+  /// non-positive values are ignored (returns false).
+  bool set_length_scale(double scale) {
+    if (!(std::isfinite(scale) && scale > 0.0)) return false;
+    opt_.length.scale = scale;
+    return true;
+  }
+  double length_scale() const { return opt_.length.scale; }
 
   /// End of the input: a walk too short for the bout gate is released if it qualifies
   /// (StepDetectorOptions::short_walk_min_steps). Take the steps afterwards.
@@ -94,6 +118,12 @@ class Pdr {
   PdrCounters counters() const;
   StepConsistency consistency() const;
   const PdrOptions& options() const { return opt_; }
+  /// Placement bouts so far (time spans, placement, walking direction in phone axes); with a
+  /// declared mount one bout per gravity-stable span, walking direction = the mount's axis.
+  std::vector<PlacementBout> placements() const { return placement_.bouts(); }
+  MotionState motion_state() const { return classifier_.state(); }
+  /// Sum of the emitted step lengths (m).
+  double distance_m() const { return distance_m_; }
 
  private:
   /// A step candidate with the heading at its own time (before the bout gate releases it).
@@ -103,28 +133,36 @@ class Pdr {
     double heading_sigma_rad = 0.0;
     bool magnetic = false;
   };
-  HeldStep hold(TimeNs t_ns, double swing_mps2) const;
+  HeldStep hold(const StepCandidate& c) const;
   void release(const std::vector<HeldStep>& steps, TimeNs now_ns);
   void emit_step(const HeldStep& h);
   bool android_active(TimeNs t_ns) const;
   void trim_consistency(TimeNs t_ns);
+  Eigen::Vector3d reference_axis() const;
+  void absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight);
+  void sync_placement();
 
   PdrOptions opt_;
   StepDetector detector_;
   BoutGate<HeldStep> gate_;
   GyroTurnTracker tracker_;
+  MotionClassifier classifier_;
+  PlacementEstimator placement_;
+  HeadingFusion fusion_;
+  std::int64_t placement_revision_ = 0;
+  Eigen::Vector3d last_field_ut_ = Eigen::Vector3d::Zero();
+  TimeNs last_gyro_ns_ = -1;
+  double distance_m_ = 0.0;
+  // the latest accelerometer step's swing, lent to Android step events (Weinberg needs one)
+  double last_swing_mps2_ = kNaN;
+  TimeNs last_swing_ns_ = -1;
   std::int64_t gaps_seen_ = 0;
   PdrCounters counters_;
-  // heading state: magnetic heading reference + yaw at that moment, propagated by the gyro
+  // heading state: time of the last absolute heading (fusion_ holds the offset)
   bool have_heading_ = false;
-  double ref_heading_mag_rad_ = 0.0;  // magnetic heading at ref_yaw
-  double ref_yaw_rad_ = 0.0;
-  double ref_sigma_rad_ = 0.0;
   TimeNs ref_t_ns_ = 0;
-  bool ref_from_rv_ = false;
   TimeNs last_rv_ns_ = 0;
   bool have_rv_ = false;
-  std::optional<double> last_rv_heading_;
   TimeNs last_rv_check_ns_ = 0;
   bool have_mag_last_ = false;
   TimeNs mag_last_ns_ = 0;

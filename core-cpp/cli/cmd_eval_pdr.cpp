@@ -1,0 +1,382 @@
+// pdnav eval-pdr LOG...: PDR trajectories on real walks with surveyed waypoints (issue 16).
+// Each log (e.g. an ILC walk converted by tools/ilc2log) is replayed; the track starts at the
+// first Truth line (waypoint) at its time and is scored at every later one. Per walk: the
+// waypoint errors, the heading error of every segment (estimated displacement vs surveyed
+// segment, + = clockwise), the length ratio (estimated path / waypoint polyline), and the same
+// for a naive PDR (peaks of low-passed |a|, 0.70 m steps, rotation-vector yaw of +Y).
+// Last line: `median_mean_error_m: X median_length_ratio: Y`.
+//   --via navigator (default): fusion::Navigator in dead-reckoning mode, exactly what
+//                              `pdnav replay --engine dr` runs;
+//   --via pdr: pdr::Pdr integrated step by step, with --length/--k to compare length models.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
+
+#include "pdnav/fusion/navigator.h"
+#include "pdnav/geo/frames.h"
+#include "pdnav/geo/wmm.h"
+#include "pdnav/io/log_reader.h"
+#include "pdnav/pdr/pdr.h"
+
+namespace pdnav::cli {
+namespace {
+
+struct EvalPdrArgs {
+  std::vector<std::string> logs;
+  std::string mount = "auto";
+  std::string via = "navigator";
+  std::string length = "default";
+  double k = kNaN;
+  double height_m = kNaN;
+  bool quiet = false;
+  bool legacy = false;
+  bool no_declination = false;  // diagnostic (--via pdr): magnetic headings, no WMM tests
+  double tau_s = kNaN;          // heading fusion offset memory (with --via pdr)
+  double field_tolerance = kNaN;
+  double disturbed_weight = kNaN;
+};
+
+/// The naive reference PDR of the issue: low-passed |a| peaks, fixed 0.70 m, RV yaw.
+class NaivePdr {
+ public:
+  void feed(const AccelSample& s) {
+    const double m = s.acc_mps2.norm();
+    if (!std::isfinite(m)) return;
+    const double dt = have_ ? ns_to_s(s.t_ns - last_ns_) : 0.0;
+    if (!have_ || dt <= 0.0 || dt > 0.5) {
+      lp_ = m, prev_ = m, prev2_ = m;
+    } else {
+      const double a = dt / (1.0 / (2.0 * kPi * kCutHz) + dt);
+      prev2_ = prev_;
+      prev_ = lp_;
+      lp_ += a * (m - lp_);
+      // a local maximum above the threshold, at least kMinGap after the last step
+      if (prev_ > prev2_ && prev_ >= lp_ && prev_ > kStandardGravity_mps2 + kPeakAboveG &&
+          ns_to_s(s.t_ns - last_step_ns_) > kMinGapS && have_yaw_) {
+        pos_en_ += kStepM * Eigen::Vector2d(std::sin(yaw_rad_), std::cos(yaw_rad_));
+        last_step_ns_ = s.t_ns;
+      }
+    }
+    have_ = true;
+    last_ns_ = s.t_ns;
+  }
+  void feed(const RotationVectorSample& s, double declination_rad) {
+    const auto h = pdr::rotation_vector_heading_rad(s.quat_xyzw, Eigen::Vector3d::UnitY(), 0.25);
+    if (h) yaw_rad_ = *h + declination_rad, have_yaw_ = true;
+  }
+  void start(const Eigen::Vector2d& en) { pos_en_ = en; }
+  const Eigen::Vector2d& pos_en() const { return pos_en_; }
+
+ private:
+  static constexpr double kCutHz = 3.0, kPeakAboveG = 1.0, kMinGapS = 0.3, kStepM = 0.70;
+  bool have_ = false, have_yaw_ = false;
+  TimeNs last_ns_ = 0, last_step_ns_ = 0;
+  double lp_ = 0, prev_ = 0, prev2_ = 0, yaw_rad_ = 0;
+  Eigen::Vector2d pos_en_ = Eigen::Vector2d::Zero();
+};
+
+struct WalkResult {
+  std::string name;
+  std::vector<double> errors_m, naive_errors_m, seg_heading_err_deg;
+  double mean_m = kNaN, naive_mean_m = kNaN, length_ratio = kNaN, naive_ratio = kNaN;
+  std::int64_t steps = 0;
+  double declination_deg = kNaN;
+};
+
+double median(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double mean(const std::vector<double>& v) {
+  if (v.empty()) return kNaN;
+  double s = 0;
+  for (double x : v) s += x;
+  return s / static_cast<double>(v.size());
+}
+
+pdr::PdrOptions pdr_options_for(const EvalPdrArgs& a) {
+  pdr::PdrOptions o;
+  o.heading.mount = pdr::mount_from_string(a.mount);
+  o.source = pdr::StepSource::kAuto;
+  o.length = std::isfinite(a.height_m) ? pdr::StepLengthModel::apt_male(a.height_m)
+                                       : pdr::StepLengthModel::unknown_walker();  // as the Navigator
+  if (a.length == "apt") o.length = pdr::StepLengthModel::apt_male(std::isfinite(a.height_m) ? a.height_m : 1.75);
+  else if (a.length == "weinberg") o.length.kind = pdr::StepLengthKind::kWeinberg;
+  else if (a.length == "frequency") o.length.kind = pdr::StepLengthKind::kFrequency;
+  else if (a.length == "constant") o.length.kind = pdr::StepLengthKind::kConstant;
+  else if (a.length != "default") throw std::invalid_argument("--length: expected default, apt, weinberg, frequency, constant");
+  if (std::isfinite(a.tau_s)) o.fusion.tau_s = a.tau_s;
+  if (std::isfinite(a.field_tolerance)) o.fusion.field_tolerance = a.field_tolerance;
+  if (std::isfinite(a.disturbed_weight)) o.fusion.disturbed_weight = a.disturbed_weight;
+  if (a.legacy) {
+    // the engine before issue 16: declared chest mount, heading = the latest rotation vector,
+    // no magnetic gating, no motion gate, APT height model with 1.75 m
+    o.heading.mount = pdr::Mount::kChestCameraOut;
+    o.fusion.tau_s = 1e-3;
+    o.fusion.field_tolerance = 1e9;
+    o.fusion.dip_tolerance_rad = 1e9;
+    o.gate_handling = false;
+    o.length = pdr::StepLengthModel::apt_male(1.75);
+  }
+  if (std::isfinite(a.k)) {
+    if (o.length.kind == pdr::StepLengthKind::kWeinberg) o.length.weinberg_k = a.k;
+    else if (o.length.kind == pdr::StepLengthKind::kFrequency) o.length.frequency_scale = a.k;
+    else if (o.length.kind == pdr::StepLengthKind::kConstant) o.length.constant_m = a.k;
+    else o.length.c1 = a.k;
+  }
+  return o;
+}
+
+/// Position source: the Navigator (dr) or a directly integrated Pdr.
+class Runner {
+ public:
+  explicit Runner(const EvalPdrArgs& a) : via_nav_(a.via == "navigator" && !a.legacy), wmm_(!a.no_declination) {
+    if (a.no_declination && a.via == "navigator") throw std::invalid_argument("--no-declination needs --via pdr");
+    if (a.via != "navigator" && a.via != "pdr") throw std::invalid_argument("--via: expected navigator or pdr");
+    if (via_nav_) {
+      fusion::NavigatorConfig c;
+      c.mode = fusion::EngineMode::kDeadReckoning;
+      c.mount = pdr::mount_from_string(a.mount);
+      c.user_height_m = a.height_m;
+      if (a.length != "default" || std::isfinite(a.k) || std::isfinite(a.tau_s) || std::isfinite(a.field_tolerance) ||
+          std::isfinite(a.disturbed_weight))
+        throw std::invalid_argument("--length/--k/--tau/--field-tolerance/--disturbed-weight need --via pdr");
+      nav_ = std::make_unique<fusion::Navigator>(c, 1);
+    } else {
+      pdr_ = std::make_unique<pdr::Pdr>(pdr_options_for(a));
+    }
+  }
+  void feed(const Sample& s) {
+    if (nav_) {
+      nav_->feed(s);
+      return;
+    }
+    std::visit(
+        [&](const auto& x) {
+          using T = std::decay_t<decltype(x)>;
+          if constexpr (std::is_same_v<T, AccelSample> || std::is_same_v<T, GyroSample> || std::is_same_v<T, MagSample> ||
+                        std::is_same_v<T, RotationVectorSample> || std::is_same_v<T, StepDetectorSample>)
+            pdr_->feed(x);
+        },
+        s);
+    for (const PdrStep& st : pdr_->take_steps()) {
+      ++steps_;
+      if (started_) {
+        const Eigen::Vector2d d = st.length_m * Eigen::Vector2d(std::sin(st.heading_rad), std::cos(st.heading_rad));
+        en_ += d;
+        path_m_ += d.norm();
+      }
+    }
+  }
+  void start(const geo::Geodetic& g, TimeNs t_ns, const geo::LocalFrame& frame) {
+    frame_ = frame;
+    started_ = true;
+    en_ = frame.to_enu(g).p_m.head<2>();
+    last_en_ = en_;
+    path_m_ = 0;
+    if (nav_) nav_->set_start(g.lat_deg(), g.lon_deg(), 1.0, t_ns);
+    if (pdr_ && wmm_) pdr_->set_location(g, kMissingInt);
+  }
+  void set_location(const geo::Geodetic& g, std::int64_t utc_ms) {
+    if (pdr_ && wmm_) pdr_->set_location(g, utc_ms);
+  }
+  /// Current east/north in the evaluation frame; accumulates the path length of the navigator.
+  std::optional<Eigen::Vector2d> position() {
+    if (!started_) return std::nullopt;
+    if (nav_) {
+      const Estimate e = nav_->estimate();
+      if (!e.valid()) return std::nullopt;
+      const Eigen::Vector2d p = frame_.to_enu(e.position).p_m.head<2>();
+      path_m_ += (p - last_en_).norm();
+      last_en_ = p;
+      return p;
+    }
+    return en_;
+  }
+  double path_m() const { return path_m_; }
+  std::int64_t steps() const { return nav_ ? nav_->output(0).steps : steps_; }
+
+ private:
+  bool via_nav_;
+  bool wmm_;
+  std::unique_ptr<fusion::Navigator> nav_;
+  std::unique_ptr<pdr::Pdr> pdr_;
+  geo::LocalFrame frame_;
+  bool started_ = false;
+  Eigen::Vector2d en_ = Eigen::Vector2d::Zero(), last_en_ = Eigen::Vector2d::Zero();
+  double path_m_ = 0;
+  std::int64_t steps_ = 0;
+};
+
+WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
+  WalkResult r;
+  r.name = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
+  io::LogReader reader(path);
+  Runner run(a);
+  NaivePdr naive;
+  geo::LocalFrame frame;
+  bool started = false;
+  const double declination = 0.0;  // naive: magnetic heading (see below)
+  std::int64_t first_utc = kMissingInt;
+  std::vector<Eigen::Vector2d> truth_en, est_en;
+  double naive_path_m = 0;
+  Eigen::Vector2d naive_last = Eigen::Vector2d::Zero();
+  Sample s;
+  while (reader.next(s)) {
+    if (const auto* m = std::get_if<AccelSample>(&s); m && first_utc == kMissingInt && m->utc_ms != kMissingInt)
+      first_utc = m->utc_ms;
+    if (const auto* t = std::get_if<TruthSample>(&s)) {
+      const geo::Geodetic g = geo::Geodetic::from_deg(t->lat_deg, t->lon_deg, 0.0);
+      if (!std::isfinite(t->lat_deg) || !std::isfinite(t->lon_deg)) continue;
+      if (!started) {
+        frame = geo::LocalFrame(g);
+        run.start(g, t->t_ns, frame);
+        naive.start(Eigen::Vector2d::Zero());
+        started = true;
+        // the naive PDR keeps the raw (magnetic) rotation-vector yaw, as the issue's naive
+        // reference does; ours gets the WMM declination like the Navigator
+        if (first_utc != kMissingInt) run.set_location(g, first_utc);
+        r.declination_deg = geo::magnetic_declination_rad(g, first_utc) / kDegToRad;
+        truth_en.push_back(Eigen::Vector2d::Zero());
+        est_en.push_back(Eigen::Vector2d::Zero());
+        continue;
+      }
+      const Eigen::Vector2d tr = frame.to_enu(g).p_m.head<2>();
+      const auto p = run.position();
+      const Eigen::Vector2d est = p ? *p : est_en.back();
+      naive_path_m += (naive.pos_en() - naive_last).norm();
+      naive_last = naive.pos_en();
+      r.errors_m.push_back((est - tr).norm());
+      r.naive_errors_m.push_back((naive.pos_en() - tr).norm());
+      const Eigen::Vector2d dt = tr - truth_en.back(), de = est - est_en.back();
+      double herr = kNaN;
+      if (dt.norm() > 1.0 && de.norm() > 0.5)
+        herr = wrap_pi(std::atan2(de.x(), de.y()) - std::atan2(dt.x(), dt.y())) / kDegToRad;
+      r.seg_heading_err_deg.push_back(herr);
+      truth_en.push_back(tr);
+      est_en.push_back(est);
+      continue;
+    }
+    run.feed(s);
+    if (started) {
+      run.position();  // accumulate the path
+      std::visit(
+          [&](const auto& x) {
+            using T = std::decay_t<decltype(x)>;
+            if constexpr (std::is_same_v<T, AccelSample>) {
+              naive.feed(x);
+              naive_path_m += (naive.pos_en() - naive_last).norm();
+              naive_last = naive.pos_en();
+            } else if constexpr (std::is_same_v<T, RotationVectorSample>) {
+              naive.feed(x, declination);
+            }
+          },
+          s);
+    } else if (const auto* rv = std::get_if<RotationVectorSample>(&s)) {
+      naive.feed(*rv, declination);
+    }
+  }
+  if (truth_en.size() < 2) throw std::runtime_error(path + ": fewer than 2 Truth lines (waypoints): nothing to score");
+  double truth_len = 0;
+  for (std::size_t i = 1; i < truth_en.size(); ++i) truth_len += (truth_en[i] - truth_en[i - 1]).norm();
+  r.mean_m = mean(r.errors_m);
+  r.naive_mean_m = mean(r.naive_errors_m);
+  r.length_ratio = truth_len > 0 ? run.path_m() / truth_len : kNaN;
+  r.naive_ratio = truth_len > 0 ? naive_path_m / truth_len : kNaN;
+  r.steps = run.steps();
+  return r;
+}
+
+std::string join(const std::vector<double>& v, int prec) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(prec);
+  for (std::size_t i = 0; i < v.size(); ++i) o << (i ? " " : "") << v[i];
+  return o.str();
+}
+
+int run_eval_pdr(const EvalPdrArgs& a) {
+  std::vector<WalkResult> all;
+  int failed = 0;
+  for (const std::string& log : a.logs) {
+    try {
+      all.push_back(eval_walk(log, a));
+    } catch (const std::exception& e) {
+      std::cerr << "eval-pdr: " << e.what() << "\n";
+      ++failed;
+      continue;
+    }
+    const WalkResult& r = all.back();
+    std::printf("%-48s wps %2zu steps %4lld mean_err_m %6.2f max %6.2f ratio %5.3f seg_heading_median %+5.1f | naive %6.2f ratio %5.3f\n",
+                r.name.c_str(), r.errors_m.size() + 1, static_cast<long long>(r.steps), r.mean_m,
+                *std::max_element(r.errors_m.begin(), r.errors_m.end()), r.length_ratio,
+                median(r.seg_heading_err_deg), r.naive_mean_m, r.naive_ratio);
+    if (!a.quiet) {
+      std::printf("    waypoint_errors_m: %s\n", join(r.errors_m, 2).c_str());
+      std::printf("    segment_heading_error_deg: %s\n", join(r.seg_heading_err_deg, 1).c_str());
+    }
+  }
+  if (all.empty()) throw std::runtime_error("no walk could be evaluated");
+  std::vector<double> means, ratios, naive_means, herr;
+  int wins = 0;
+  for (const auto& r : all) {
+    means.push_back(r.mean_m);
+    ratios.push_back(r.length_ratio);
+    naive_means.push_back(r.naive_mean_m);
+    wins += r.mean_m < r.naive_mean_m;
+    for (double h : r.seg_heading_err_deg) herr.push_back(h);
+  }
+  std::vector<double> abs_herr;
+  for (double h : herr) abs_herr.push_back(std::abs(h));
+  std::printf("walks %zu (failed %d); better than naive in %d; naive median_mean_error_m %.2f\n", all.size(), failed, wins,
+              median(naive_means));
+  std::printf("segment heading error: median signed %.1f deg, median |.| %.1f deg over %zu segments; WMM declination %.1f deg\n",
+              median(herr), median(abs_herr), herr.size(), all.front().declination_deg);
+  std::printf("median_mean_error_m: %.2f median_length_ratio: %.3f\n", median(means), median(ratios));
+  return failed ? 1 : 0;
+}
+
+}  // namespace
+
+void register_eval_pdr(CLI::App& app) {
+  auto a = std::make_shared<EvalPdrArgs>();
+  CLI::App* c = app.add_subcommand("eval-pdr", "PDR on real walks with surveyed waypoints (Truth lines): errors per walk");
+  c->add_option("logs", a->logs, "session logs with Truth lines (tools/ilc2log converts the ILC walks)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  c->add_option("--mount", a->mount, "auto | chest | chest-camera-out | chest-screen-out | hand")->capture_default_str();
+  c->add_option("--via", a->via, "navigator (= replay --engine dr) | pdr (direct, for --length)")->capture_default_str();
+  c->add_option("--length", a->length, "with --via pdr: default | apt | weinberg | frequency | constant")
+      ->capture_default_str();
+  c->add_option("--k", a->k, "with --via pdr: the length model's constant (c1, Weinberg K, frequency scale, metres)");
+  c->add_option("--height", a->height_m, "walker height in metres (APT height model); default: unknown");
+  c->add_option("--tau", a->tau_s, "with --via pdr: heading-fusion offset memory, s");
+  c->add_option("--field-tolerance", a->field_tolerance, "with --via pdr: |B| tolerance vs WMM (fraction)");
+  c->add_option("--disturbed-weight", a->disturbed_weight, "with --via pdr: weight of a disturbed reading");
+  c->add_flag("--no-declination", a->no_declination,
+              "diagnostic, with --via pdr: no WMM (magnetic headings, no field tests)");
+  c->add_flag("--quiet", a->quiet, "one line per walk");
+  c->add_flag("--legacy", a->legacy,
+              "the engine as before issue 16 (chest mount, latest rotation vector, APT 1.75 m, no motion gate)");
+  c->callback([a]() {
+    const int rc = run_eval_pdr(*a);
+    if (rc != 0) throw CLI::RuntimeError(rc);
+  });
+}
+
+}  // namespace pdnav::cli

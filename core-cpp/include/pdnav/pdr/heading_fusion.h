@@ -1,0 +1,84 @@
+// Gyro-dominant heading (issue 16): the gyro carries the heading between absolute readings;
+// the absolute heading (rotation vector, else tilt-compensated compass) only sets the offset
+// between the integrated gyro yaw and north, as a weighted circular mean over the last tau_s.
+// The offset is fitted as a straight line in time (weighted least squares with the same
+// forgetting), so a residual gyro bias about the vertical is estimated too (clamped to
+// max_drift_radps, shrunk toward 0 while the readings span less than drift_prior_s).
+// A magnetometer reading is trusted (weight 1) only when its field magnitude and dip agree
+// with the WMM at the location (Afzal, Renaudin, Lachapelle, "Assessment of indoor magnetic
+// field anomalies using multiple magnetometers", ION GNSS 2010, and their quasi-static field
+// detector use the same two tests); a disturbed one gets disturbed_weight, so a session that
+// is disturbed everywhere still converges to its average. Indoors the field is disturbed
+// locally (median |B| 41 uT vs 48 uT WMM on the ILC walks): averaging the offset over tens of
+// metres of walking averages the disturbances out, the gyro keeps the shape of the path.
+#pragma once
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "pdnav/geo/samples.h"
+#include "pdnav/geo/units.h"
+
+namespace pdnav::pdr {
+
+struct HeadingFusionOptions {
+  double tau_s = 60.0;                    // offset memory; gyro drift ~0.2 deg/s -> <= 12 deg per tau
+  double no_gyro_tau_s = 0.3;             // without a live gyro the absolute heading is followed
+  double field_tolerance = 0.15;          // |B| within 15 % of the WMM total intensity
+  double dip_tolerance_rad = 10 * kDegToRad;  // dip within 10 deg of the WMM inclination
+  double disturbed_weight = 0.05;         // weight of a reading failing either test
+  double base_sigma_rad = 15 * kDegToRad; // 1-sigma of one absolute reading
+  double decorrelation_s = 5.0;           // readings closer than this are not independent
+  double min_sigma_rad = 3 * kDegToRad;
+  double max_drift_radps = 1.0 * kDegToRad;  // |estimated gyro yaw drift| at most (MEMS: < 0.5 deg/s)
+  double drift_prior_s = 5.0;             // ridge on the drift: time spread needed to trust it
+  // Consistency: mean resultant length of the offsets (1 = all agree). Below this the gyro and
+  // the absolute readings contradict each other (e.g. a heading that flips 180 deg while the
+  // gyro is still): the offset is unknown, the latest reading is followed (the pre-fusion
+  // behaviour) until they agree again.
+  double min_consistency = 0.5;
+};
+
+class HeadingFusion {
+ public:
+  explicit HeadingFusion(const HeadingFusionOptions& options = {});
+  /// The expected field (WMM total intensity in uT and inclination, down positive).
+  void set_reference_field(double total_ut, double inclination_rad);
+  /// Weight of a magnetometer reading (phone axes) given "up" in phone axes: 1 if it passes
+  /// the magnitude and dip tests (or no reference field is known), else disturbed_weight.
+  double field_weight(const Eigen::Vector3d& field_ut, const Eigen::Vector3d& up_phone) const;
+  /// One absolute heading (magnetic, of the reference axis) at gyro yaw yaw_rad (left +).
+  void add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, double weight, bool gyro_live);
+  void reset();
+  bool valid() const { return weight_ > 0.0; }
+  /// Magnetic heading of the reference axis at gyro yaw yaw_rad and time t_ns.
+  double heading_mag_rad(double yaw_rad, TimeNs t_ns) const;
+  /// Estimated drift of the gyro yaw (rad/s, of the offset c = heading + yaw).
+  double drift_radps() const;
+  double sigma_rad() const;
+  std::int64_t accepted() const { return accepted_; }
+  std::int64_t disturbed() const { return disturbed_; }
+
+ private:
+  HeadingFusionOptions opt_;
+  double ref_total_ut_ = kNaN, ref_dip_rad_ = kNaN;
+  // decayed weighted sums of the line fit y = a + b tau, tau = t - last_ns_ (re-anchored at
+  // every reading), y = offset unwrapped around anchor_rad_
+  struct LineSums {
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, y0 = 0.0, y1 = 0.0;
+    void shift_and_decay(double dt_s, double decay);
+    void add(double w, double y) { s0 += w, y0 += w * y; }  // at tau = 0
+  };
+  double anchor_rad_ = 0.0;
+  LineSums all_;      // every reading: the offset
+  LineSums trusted_;  // readings that passed the tests only: the drift (a disturbance is not a slope)
+  double weight_ = 0.0;                            // decayed sum of w (= all_.s0)
+  Eigen::Vector2d circ_ = Eigen::Vector2d::Zero();  // decayed sum of w (cos c, sin c)
+  double last_c_rad_ = 0.0;                         // the latest reading's offset
+  double weight_s_ = 0.0;                          // decayed sum of w dt (information, seconds)
+  bool have_last_ = false;
+  TimeNs last_ns_ = 0;
+  std::int64_t accepted_ = 0, disturbed_ = 0;
+};
+
+}  // namespace pdnav::pdr

@@ -1,0 +1,149 @@
+// Placement and walking direction from the motion (docs/pdr.md, "Placement").
+#include "pdnav/pdr/placement.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+namespace pdnav::pdr {
+
+const char* to_string(Placement p) {
+  switch (p) {
+    case Placement::kFlat: return "flat";
+    case Placement::kUpright: return "upright";
+    case Placement::kOther: return "other";
+    case Placement::kUnknown: break;
+  }
+  return "unknown";
+}
+
+PlacementEstimator::PlacementEstimator(const PlacementOptions& options) : opt_(options) {}
+
+void PlacementEstimator::end_bout() {
+  if (in_bout_) closed_.push_back(bout_);
+  in_bout_ = false;
+  moved_since_ns_ = -1;
+}
+
+void PlacementEstimator::start_bout(TimeNs t_ns) {
+  in_bout_ = true;
+  bout_ = PlacementBout{};
+  bout_.t_start_ns = bout_.t_end_ns = t_ns;
+  bout_up_ = up_;
+  corr_.setZero();
+  cov_h_.setZero();
+  var_v_ = n_corr_ = walking_s_ = 0.0;
+  // placement from the dominant gravity axis; the reference axis is the placement's prior
+  // walking axis (flat: +Y, upright: -Z), else the most horizontal of +X, +Y, -Z
+  const double ax = std::abs(up_.x()), ay = std::abs(up_.y()), az = std::abs(up_.z());
+  if (az >= ax && az >= ay && az >= opt_.flat_min) {
+    bout_.placement = Placement::kFlat;
+    reference_ = Eigen::Vector3d::UnitY();
+  } else if (ay >= ax && ay >= az && ay >= opt_.upright_min) {
+    bout_.placement = Placement::kUpright;
+    reference_ = -Eigen::Vector3d::UnitZ();
+  } else {
+    bout_.placement = Placement::kOther;
+    reference_ = (az <= ax && az <= ay) ? Eigen::Vector3d(-Eigen::Vector3d::UnitZ())
+                 : (ay <= ax)           ? Eigen::Vector3d(Eigen::Vector3d::UnitY())
+                                        : Eigen::Vector3d(Eigen::Vector3d::UnitX());
+  }
+  ++revision_;
+  update_forward();
+}
+
+void PlacementEstimator::feed(const AccelSample& s, bool walking) {
+  if (!s.acc_mps2.allFinite()) return;
+  if (have_last_ && s.t_ns <= last_ns_) return;
+  const double dt = have_last_ ? ns_to_s(s.t_ns - last_ns_) : 0.0;
+  if (have_last_ && dt > 0.5) {  // a gap: statistics restart, the bout goes on
+    win_.clear();
+    sum_.setZero();
+    hist_.clear();
+  }
+  have_last_ = true;
+  last_ns_ = s.t_ns;
+  win_.emplace_back(s.t_ns, s.acc_mps2);
+  sum_ += s.acc_mps2;
+  while (!win_.empty() && win_.front().first <= s.t_ns - s_to_ns(opt_.gravity_window_s)) {
+    sum_ -= win_.front().second;
+    win_.pop_front();
+  }
+  const Eigen::Vector3d mean = sum_ / static_cast<double>(win_.size());
+  if (win_.size() < 2 || ns_to_s(win_.back().first - win_.front().first) < 0.5 * opt_.gravity_window_s ||
+      mean.norm() < 0.3 * kStandardGravity_mps2)
+    return;
+  up_ = mean.normalized();
+  have_up_ = true;
+  if (!in_bout_) start_bout(s.t_ns);
+  bout_.t_end_ns = s.t_ns;
+  // placement change: gravity moved in phone axes and stayed moved
+  if (std::acos(std::clamp(up_.dot(bout_up_), -1.0, 1.0)) > opt_.change_angle_rad) {
+    if (moved_since_ns_ < 0) moved_since_ns_ = s.t_ns;
+    if (ns_to_s(s.t_ns - moved_since_ns_) >= opt_.change_hold_s) {
+      end_bout();
+      start_bout(s.t_ns);
+      return;
+    }
+  } else {
+    moved_since_ns_ = -1;
+  }
+  // vertical and horizontal linear acceleration; horizontal kept for the lagged product
+  const Eigen::Vector3d lin = s.acc_mps2 - mean;
+  const double av = lin.dot(up_);
+  const Eigen::Vector3d h = lin - av * up_;
+  hist_.emplace_back(s.t_ns, h);
+  const TimeNs lag_t = s.t_ns - s_to_ns(opt_.phase_lag_s);
+  while (hist_.size() > 1 && hist_[1].first <= lag_t) hist_.pop_front();
+  if (walking && hist_.front().first <= lag_t && ns_to_s(lag_t - hist_.front().first) < 0.05) {
+    const Eigen::Vector3d& hl = hist_.front().second;
+    corr_ += av * hl;
+    cov_h_ += hl * hl.transpose();
+    var_v_ += av * av;
+    n_corr_ += 1.0;
+    walking_s_ += dt;
+    update_forward();
+  }
+}
+
+void PlacementEstimator::update_forward() {
+  const bool trusted = walking_s_ >= opt_.min_bout_s && var_v_ > 0.0;
+  if (bout_.placement == Placement::kFlat || bout_.placement == Placement::kUpright) {
+    const Eigen::Vector3d prior = bout_.placement == Placement::kFlat ? Eigen::Vector3d(Eigen::Vector3d::UnitY())
+                                                                      : Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
+    double c = 0.0;
+    const double vf = prior.dot(cov_h_ * prior);
+    if (trusted && vf > 0.0) c = prior.dot(corr_) / std::sqrt(var_v_ * vf);
+    bout_.phase_corr = c;
+    bout_.forward_phone = (trusted && c < opt_.flip_corr) ? Eigen::Vector3d(-prior) : prior;
+    return;
+  }
+  // other placements: the lagged correlation vector, horizontal part
+  Eigen::Vector3d d = corr_ - corr_.dot(up_) * up_;
+  if (trusted && d.norm() > 1e-9) {
+    d.normalize();
+    bout_.forward_phone = d;
+    const double vf = d.dot(cov_h_ * d);
+    bout_.phase_corr = vf > 0.0 ? d.dot(corr_) / std::sqrt(var_v_ * vf) : 0.0;
+  } else {
+    bout_.forward_phone = reference_;
+    bout_.phase_corr = 0.0;
+  }
+}
+
+double PlacementEstimator::forward_offset_rad() const {
+  const Eigen::Vector3d r = reference_ - reference_.dot(up_) * up_;
+  const Eigen::Vector3d f = bout_.forward_phone - bout_.forward_phone.dot(up_) * up_;
+  if (r.norm() < 0.2 || f.norm() < 0.2) return 0.0;
+  const double ccw = std::atan2(r.cross(f).dot(up_), r.dot(f));
+  return -ccw;  // clockwise seen from above
+}
+
+std::vector<PlacementBout> PlacementEstimator::bouts() const {
+  std::vector<PlacementBout> out = closed_;
+  if (in_bout_) out.push_back(bout_);
+  return out;
+}
+
+}  // namespace pdnav::pdr

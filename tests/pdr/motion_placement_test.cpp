@@ -1,0 +1,277 @@
+// Issue 16: the motion classifier (no steps from a waved phone), placement / walking direction
+// without a declared mount, the gyro-dominant heading with WMM-gated magnetic readings, and the
+// step-length models. Real data: one ILC 2020 hand-held walk (../shared/data/pdr-ilc2020).
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "pdnav/geo/wmm.h"
+#include "pdnav/pdr/heading_fusion.h"
+#include "pdnav/pdr/motion_classifier.h"
+#include "pdnav/pdr/pdr.h"
+#include "pdnav/pdr/placement.h"
+#include "test_data.h"
+
+using namespace pdnav;
+using namespace pdnav::pdr;
+
+namespace {
+
+struct RealWalk {
+  std::vector<AccelSample> accel;
+  std::vector<GyroSample> gyro;
+  std::vector<RotationVectorSample> rotation;
+};
+
+/// The sensor lines of one ILC walk (tab-separated "unix_ms TYPE x y z [acc]").
+RealWalk read_ilc(const std::string& path) {
+  RealWalk w;
+  std::ifstream in(path);
+  EXPECT_TRUE(in.good()) << path;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream ss(line);
+    std::int64_t ms = 0;
+    std::string type;
+    double x = 0, y = 0, z = 0;
+    if (!(ss >> ms >> type >> x >> y >> z)) continue;
+    const TimeNs t = ms * 1'000'000;
+    if (type == "TYPE_ACCELEROMETER") w.accel.push_back({t, ms, {x, y, z}});
+    else if (type == "TYPE_GYROSCOPE") w.gyro.push_back({t, ms, {x, y, z}});
+    else if (type == "TYPE_ROTATION_VECTOR")
+      w.rotation.push_back({t, ms, {x, y, z, std::sqrt(std::max(0.0, 1 - x * x - y * y - z * z))}, kNaN});
+  }
+  return w;
+}
+
+const char* kWalk = "pdr-ilc2020/data/site2/F3/path_data_files/5dd38fff44333f00067aa387.txt";
+
+/// 30 s of compass-calibration waving: figure-eight wrist rotations (1:2 frequency ratio about
+/// two axes, a third slower one) at 0.6-1.2 Hz with a seeded drifting rate, amplitudes
+/// 35-70 deg (times `amplitude`), and hand translation of 1.5-3 m/s^2 (times `amplitude`), ending in the attitude the walk starts with.
+/// The sensor noise is the real walk's own: the residual of its first samples around their
+/// 0.2 s mean is added to every synthetic sample.
+RealWalk make_waving(const RealWalk& real, TimeNs t_end_ns, double seconds, std::uint64_t seed, double amplitude) {
+  RealWalk w;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  const double rate_hz = 50.0, dt = 1.0 / rate_hz;
+  const int n = static_cast<int>(seconds * rate_hz);
+  // real noise: residuals of the first 100 samples around a 10-sample running mean
+  std::vector<Eigen::Vector3d> acc_noise, gyro_noise;
+  for (std::size_t i = 5; i + 5 < std::min<std::size_t>(real.accel.size(), 105); ++i) {
+    Eigen::Vector3d ma = Eigen::Vector3d::Zero(), mg = Eigen::Vector3d::Zero();
+    for (std::size_t k = i - 5; k < i + 5; ++k) ma += real.accel[k].acc_mps2, mg += real.gyro[k].rate_radps;
+    acc_noise.push_back(real.accel[i].acc_mps2 - ma / 10.0);
+    gyro_noise.push_back(real.gyro[i].rate_radps - mg / 10.0);
+  }
+  const Eigen::Vector3d g0 = real.accel.front().acc_mps2;  // the walk's first attitude (gravity)
+  const Eigen::Quaterniond q0 = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), g0.normalized());
+  double phase = 0.0, f_hz = 0.9;
+  auto attitude = [&](double ph, double fade) {
+    return q0 * Eigen::AngleAxisd(fade * 70 * kDegToRad * std::sin(ph), Eigen::Vector3d::UnitZ()) *
+           Eigen::AngleAxisd(fade * 55 * kDegToRad * std::sin(2 * ph + 0.6), Eigen::Vector3d::UnitX()) *
+           Eigen::AngleAxisd(fade * 35 * kDegToRad * std::sin(0.5 * ph + 1.1), Eigen::Vector3d::UnitY());
+  };
+  Eigen::Quaterniond prev = attitude(0.0, 0.0);
+  for (int i = 0; i < n; ++i) {
+    const double t = i * dt;
+    f_hz = std::clamp(f_hz + 0.05 * n01(rng), 0.6, 1.2);
+    phase += 2 * kPi * f_hz * dt;
+    const double fade = amplitude * std::min({1.0, t / 1.0, (seconds - t) / 1.0});  // 1 s in, 1 s out
+    const Eigen::Quaterniond q = attitude(phase, std::max(0.0, fade));
+    const Eigen::AngleAxisd rel(prev.conjugate() * q);
+    prev = q;
+    Eigen::Vector3d rate = rel.angle() < 1e-12 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(rel.axis() * rel.angle() / dt);
+    // hand translation in the world (phone-start frame), 1.5-3 m/s^2
+    const Eigen::Vector3d lin_world(2.5 * std::sin(phase + 0.3), 1.5 * std::sin(2 * phase), 3.0 * std::sin(phase * 1.5 + 2.0));
+    // specific force in phone axes: q maps phone -> start frame whose z is the walk's gravity
+    Eigen::Vector3d f = q.conjugate() * (Eigen::Vector3d(0, 0, g0.norm()) + std::max(0.0, fade) * lin_world);
+    f += acc_noise[i % acc_noise.size()];
+    rate += gyro_noise[i % gyro_noise.size()];
+    const TimeNs t_ns = t_end_ns - static_cast<TimeNs>((n - i) * dt * 1e9);
+    w.accel.push_back({t_ns, kMissingInt, f});
+    w.gyro.push_back({t_ns, kMissingInt, rate});
+  }
+  return w;
+}
+
+std::vector<PdrStep> run(const PdrOptions& o, const RealWalk& a, const RealWalk* b = nullptr) {
+  Pdr p(o);
+  std::vector<PdrStep> out;
+  auto feed = [&](const RealWalk& w) {
+    std::size_t ig = 0, ir = 0;
+    for (const auto& s : w.accel) {
+      while (ig < w.gyro.size() && w.gyro[ig].t_ns <= s.t_ns) p.feed(w.gyro[ig++]);
+      while (ir < w.rotation.size() && w.rotation[ir].t_ns <= s.t_ns) p.feed(w.rotation[ir++]);
+      p.feed(s);
+      for (const auto& st : p.take_steps()) out.push_back(st);
+    }
+  };
+  feed(a);
+  if (b) feed(*b);
+  return out;
+}
+
+}  // namespace
+
+TEST(PdrMotion, ThirtySecondsOfWavingBeforeARealWalkCountNoSteps) {
+  const RealWalk walk = read_ilc(pdnav::test::shared_data(kWalk));
+  ASSERT_GT(walk.accel.size(), 1000u);
+  const TimeNs start = walk.accel.front().t_ns;
+  PdrOptions o;
+  o.heading.mount = Mount::kAuto;
+  const std::size_t walk_only = run(o, walk).size();
+  ASSERT_GT(walk_only, 40u);
+  for (std::uint64_t seed : {1u, 2u, 3u, 4u}) {
+    // seeds 3 and 4: gentle waving, half the rotation and translation
+    const RealWalk waving = make_waving(walk, start - 20'000'000, 30.0, seed, seed <= 2 ? 1.0 : 0.5);
+    const auto steps = run(o, waving, &walk);
+    std::size_t in_waving = 0;
+    for (const auto& s : steps) in_waving += s.t_ns < start;
+    EXPECT_LE(in_waving, 2u) << "seed " << seed;
+    // the walk after it keeps its steps (within 3 + 5 %)
+    EXPECT_NEAR(static_cast<double>(steps.size() - in_waving), static_cast<double>(walk_only),
+                3.0 + 0.05 * static_cast<double>(walk_only))
+        << "seed " << seed;
+    // the synthesised waving is a real challenge: without the classifier it makes steps
+    PdrOptions ungated = o;
+    ungated.gate_handling = false;
+    std::size_t ungated_in_waving = 0;
+    for (const auto& s : run(ungated, waving, &walk)) ungated_in_waving += s.t_ns < start;
+    EXPECT_GT(ungated_in_waving, 10u) << "seed " << seed;
+  }
+}
+
+TEST(PdrMotion, WalkingWithASwingingHandIsNotHandling) {
+  // one-axis rotation (arm swing, +-40 deg at 0.9 Hz): high rate, low axis spread
+  MotionClassifier c;
+  for (int i = 0; i < 500; ++i) {
+    const double t = i * 0.01;
+    const double w = 40 * kDegToRad * 2 * kPi * 0.9 * std::cos(2 * kPi * 0.9 * t);
+    c.feed(GyroSample{static_cast<TimeNs>(t * 1e9), kMissingInt, {w, 0.05 * w, 0.1}});
+    c.feed(AccelSample{static_cast<TimeNs>(t * 1e9), kMissingInt, {0, 0, 9.8 + 2 * std::sin(2 * kPi * 1.8 * t)}});
+  }
+  EXPECT_GT(c.rate_rms_radps(), 1.2);
+  EXPECT_LT(c.axis_spread(), 0.25);
+  EXPECT_EQ(c.state(), MotionState::kWalking);
+  EXPECT_TRUE(c.handling_spans().empty());
+}
+
+TEST(PdrPlacement, RealHandHeldWalkIsFlatWithTopAheadAndAReversedPhoneIsFound) {
+  const RealWalk walk = read_ilc(pdnav::test::shared_data(kWalk));
+  {
+    PlacementEstimator est;
+    for (const auto& s : walk.accel) est.feed(s, true);
+    ASSERT_FALSE(est.bouts().empty());
+    EXPECT_EQ(est.placement(), Placement::kFlat);
+    EXPECT_GT(est.forward_phone().y(), 0.99);
+    EXPECT_GT(est.bouts().back().phase_corr, 0.25);
+  }
+  {
+    // the same walk with the phone turned 180 deg about its z axis (top toward the walker)
+    PlacementEstimator est;
+    for (auto s : walk.accel) {
+      s.acc_mps2.x() = -s.acc_mps2.x();
+      s.acc_mps2.y() = -s.acc_mps2.y();
+      est.feed(s, true);
+    }
+    EXPECT_EQ(est.placement(), Placement::kFlat);
+    EXPECT_LT(est.forward_phone().y(), -0.99);
+    EXPECT_NEAR(std::abs(wrap_pi(est.forward_offset_rad())), kPi, 0.2);
+  }
+}
+
+TEST(PdrPlacement, APlacementChangeStartsANewBout) {
+  PlacementEstimator est;
+  for (int i = 0; i < 1000; ++i) {  // 10 s flat, then 10 s upright
+    const double t = i * 0.01;
+    const Eigen::Vector3d g = i < 500 ? Eigen::Vector3d(0, 0, 9.8) : Eigen::Vector3d(0, 9.8, 0);
+    est.feed(AccelSample{static_cast<TimeNs>(t * 1e9), kMissingInt, g + Eigen::Vector3d(0, 0, 0.5 * std::sin(11 * t))},
+             true);
+  }
+  const auto b = est.bouts();
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_EQ(b[0].placement, Placement::kFlat);
+  EXPECT_EQ(b[1].placement, Placement::kUpright);
+  EXPECT_NEAR(ns_to_s(b[1].t_start_ns), 6.5, 1.5);  // moved at 5 s, confirmed after the hold
+}
+
+TEST(PdrHeadingFusion, DisturbedReadingsBarelyMoveTheGyroHeading) {
+  const geo::Geodetic where = geo::Geodetic::from_deg(30.3, 120.1, 0);
+  const geo::MagneticField f = geo::wmm_field(geo::WmmModel::wmm2025(), where, 2025.5);
+  HeadingFusion h;
+  h.set_reference_field(f.f_nt * 1e-3, f.inclination_rad);
+  const Eigen::Vector3d up(0, 0, 1);
+  // a field that matches WMM (phone flat, +Y north): north component H, down component Z
+  const Eigen::Vector3d good(0, f.h_nt * 1e-3, -f.z_nt * 1e-3);
+  const Eigen::Vector3d bad = 1.4 * good;  // a steel structure: 40 % too strong
+  EXPECT_DOUBLE_EQ(h.field_weight(good, up), 1.0);
+  EXPECT_LT(h.field_weight(bad, up), 0.1);
+  // 20 s of good readings saying 30 deg while the gyro turns the phone steadily
+  TimeNs t = 0;
+  for (int i = 0; i < 1000; ++i, t += 20'000'000) {
+    const double yaw = 0.01 * i;
+    h.add(t, wrap_two_pi(30 * kDegToRad - yaw), yaw, h.field_weight(good, up), true);
+  }
+  EXPECT_NEAR(wrap_pi(h.heading_mag_rad(10.0, t) - (30 * kDegToRad - 10.0)), 0.0, 1e-6);
+  // then 10 s of disturbed readings 60 deg off: the heading moves by less than 5 deg
+  for (int i = 0; i < 500; ++i, t += 20'000'000) h.add(t, 90 * kDegToRad, 10.0, h.field_weight(bad, up), true);
+  EXPECT_LT(std::abs(wrap_pi(h.heading_mag_rad(10.0, t) - (30 * kDegToRad - 10.0))), 5 * kDegToRad);
+  // the same readings, trusted (no reference field), pull it most of the way
+  HeadingFusion trusting;
+  for (int i = 0; i < 1000; ++i) trusting.add(i * 20'000'000LL, 30 * kDegToRad, 0.0, 1.0, true);
+  for (int i = 1000; i < 1500; ++i) trusting.add(i * 20'000'000LL, 90 * kDegToRad, 0.0, 1.0, true);
+  EXPECT_GT(std::abs(wrap_pi(trusting.heading_mag_rad(0.0, 1500 * 20000000LL) - 30 * kDegToRad)), 10 * kDegToRad);
+}
+
+TEST(PdrStepLength, FrequencyModelAndLearnedScale) {
+  StepLengthModel m;
+  m.kind = StepLengthKind::kFrequency;
+  m.height_m = 1.75;
+  EXPECT_NEAR(m.length_m(kNaN, 1.79), 0.70, 1e-12);         // Tian et al. 2016 at the mean cadence
+  EXPECT_NEAR(m.length_m(kNaN, 2.29), 0.70 + 0.1135, 1e-12);
+  EXPECT_NEAR(m.length_m(kNaN, 0.1), 0.70, 1e-12);          // implausible cadence: the mean
+  m.scale = 0.9;
+  EXPECT_NEAR(m.length_m(kNaN, 1.79), 0.63, 1e-12);
+  Pdr p;
+  EXPECT_TRUE(p.set_length_scale(0.85));
+  EXPECT_FALSE(p.set_length_scale(-1.0));
+  EXPECT_FALSE(p.set_length_scale(kNaN));
+  EXPECT_DOUBLE_EQ(p.length_scale(), 0.85);
+  p.set_length_model(StepLengthModel::apt_male(1.8));  // a new model keeps the learned scale
+  EXPECT_DOUBLE_EQ(p.length_scale(), 0.85);
+}
+
+TEST(PdrMotion, AndroidStepEventsWhileWavingAreRefused) {
+  // a phone's own step detector that counts the waving (1.6 Hz events) must not make steps
+  const RealWalk walk = read_ilc(pdnav::test::shared_data(kWalk));
+  const TimeNs start = walk.accel.front().t_ns;
+  const RealWalk waving = make_waving(walk, start, 30.0, 7, 1.0);
+  PdrOptions o;
+  o.heading.mount = Mount::kAuto;
+  o.source = StepSource::kAuto;
+  for (bool gate : {true, false}) {
+    o.gate_handling = gate;
+    Pdr p(o);
+    std::size_t ig = 0, counted = 0;
+    TimeNs next_event = waving.accel.front().t_ns + 2'000'000'000;
+    for (const auto& s : waving.accel) {
+      while (ig < waving.gyro.size() && waving.gyro[ig].t_ns <= s.t_ns) p.feed(waving.gyro[ig++]);
+      p.feed(s);
+      if (s.t_ns >= next_event) {
+        p.feed(StepDetectorSample{s.t_ns, kMissingInt});
+        next_event += 625'000'000;
+      }
+      counted += p.take_steps().size();
+    }
+    if (gate) EXPECT_LE(counted, 2u);
+    else EXPECT_GT(counted, 30u);  // the events are there: only the gate removes them
+  }
+}
