@@ -46,6 +46,8 @@ struct GnssEngine::Impl {
   std::int64_t last_gps_ns = 0;
   int epochs_since_update = 0;
   int last_sats_used = 0;
+  bool have_clock_system = false;
+  Constellation kf_clock_system = Constellation::kGps;
   std::string last_reason;
 
   void count(const std::string& reason, std::int64_t n = 1) { excluded[reason] += n; }
@@ -163,7 +165,15 @@ struct GnssEngine::Impl {
     last_t_ns = ep.t_ns;
     last_gps_ns = ep.rx.ns;
     last_sats_used = sol.sats_used;
+    sol.status = status();
     solutions.push_back(sol);
+  }
+
+  EstimateStatus status() const {
+    if (!kf.initialized()) return EstimateStatus::kNotInitialized;
+    if (epochs_since_update >= opt.lost_after_epochs) return EstimateStatus::kLost;
+    if (epochs_since_update > 0 || last_sats_used < opt.min_sats_ok) return EstimateStatus::kDegraded;
+    return EstimateStatus::kOk;
   }
 
   DisplacementSolution displacement(const std::vector<CarrierObservation>& obs, double dt) {
@@ -188,6 +198,16 @@ struct GnssEngine::Impl {
     }
     ++epochs_since_update;
     if (spp.ok) {
+      // the SPP clock is the clock of its reference system (GPS when present); when that
+      // system changes, the clock state jumps by an ISB: re-initialise the clock instead of
+      // rejecting updates until the filter hard-resets
+      if (kf.initialized() && have_clock_system && spp.clock_system != kf_clock_system) {
+        count("kf: reference clock system changed (clock re-initialised)");
+        kf.reset_clock(spp.clock_m, 1e12);
+      }
+      kf_clock_system = spp.clock_system;
+      have_clock_system = true;
+      sol.clock_system = spp.clock_system;
       const bool was_initialized = kf.initialized();
       const KalmanUpdateResult u = kf.update(spp.pos, spp.pos_cov_ecef, spp.clock_m, spp.clock_var_m2);
       sol.kf_update_accepted = u.accepted;
@@ -225,6 +245,22 @@ void GnssEngine::feed(const GnssRawSample& s) {
   m.pending.push_back(s);
 }
 
+void GnssEngine::feed_epoch(const std::vector<GnssRawSample>& rows) {
+  flush();
+  Impl& m = *impl_;
+  std::vector<GnssRawSample> ok;
+  ok.reserve(rows.size());
+  for (const GnssRawSample& r : rows) {
+    if (r.time_nanos == kMissingInt) { m.count("row: TimeNanos missing"); continue; }
+    if (!ok.empty() && r.time_nanos != ok.front().time_nanos) {  // not one epoch after all
+      m.process(ok);
+      ok.clear();
+    }
+    ok.push_back(r);
+  }
+  if (!ok.empty()) m.process(ok);
+}
+
 void GnssEngine::feed(const NavMessageSample& s) {
   Impl& m = *impl_;
   if (s.type != kGpsL1CaNavType) { m.count("nav: unsupported message type"); return; }
@@ -253,6 +289,7 @@ void GnssEngine::reset() {
   m.has_prev = false;
   m.have_pos = false;
   m.epochs_since_update = 0;
+  m.have_clock_system = false;
 }
 
 Estimate GnssEngine::estimate() const {
