@@ -36,6 +36,8 @@ struct GnssArgs {
   bool strip_adr = false;
   double smoothing_window_s = gnss::SmoothingOptions{}.window_s;
   std::uint64_t seed = 1;
+  double kf_displacement_q_m2 = gnss::KalmanOptions{}.displacement_q_m2;
+  double kf_fix_scale = gnss::KalmanOptions{}.fix_variance_scale;
 };
 
 geo::Geodetic parse_truth(const std::string& s) {
@@ -223,6 +225,8 @@ void run_gnss(const GnssArgs& a) {
   }
   gnss::GnssOptions options;
   options.smoothing.window_s = a.smoothing_window_s;
+  options.kalman.displacement_q_m2 = a.kf_displacement_q_m2;
+  options.kalman.fix_variance_scale = a.kf_fix_scale;
   gnss::GnssEngine engine(options, store, a.seed);
   std::int64_t raw_rows = 0;
   const std::vector<gnss::EpochSolution> sols = run(a, engine, raw_rows);
@@ -276,6 +280,10 @@ void register_gnss(CLI::App& app) {
   cmd->add_flag("--strip-adr", args->strip_adr, "drop carrier phase (tests the Doppler fallback)");
   cmd->add_option("--smoothing-window", args->smoothing_window_s,
                   "carrier smoothing window of the code, s (RTCA DO-229: 100; 0 = raw code)")->check(CLI::Range(0.0, 3600.0));
+  cmd->add_option("--kf-displacement-q", args->kf_displacement_q_m2,
+                  "KF process noise added to each displacement, m^2 per epoch")->check(CLI::Range(0.0, 1e6));
+  cmd->add_option("--kf-fix-scale", args->kf_fix_scale, "KF: multiplies the SPP covariance used as R")
+      ->check(CLI::Range(1e-3, 1e6));
   cmd->add_option("--seed", args->seed, "engine seed (the engine is deterministic)");
   cmd->callback([args]() { run_gnss(*args); });
 }

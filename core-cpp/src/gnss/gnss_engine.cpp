@@ -106,14 +106,13 @@ struct GnssEngine::Impl {
     smoother.begin_epoch(has_prev ? dt : 0.0, d_bias_ns * 1e-9 * kSpeedOfLight_mps);
     std::vector<SppObservation> spp_obs;
     std::vector<CarrierObservation> car_obs;
+    std::vector<SmoothingInput> sm_in;
     for (const Measurement& m : ep.meas) {
       SatState st;
       if (!sat_state(m, ep.rx, st)) continue;
       if (m.code_ok()) {
-        std::string why;
-        const double pr = smoother.smooth(SmoothingInput{m.sat, m.pseudorange_m, m.adr_ok() ? m.adr_m : kNaN, m.pr_rate_mps}, &why);
-        if (!why.empty()) count(why);
-        spp_obs.push_back(SppObservation{m.sat, pr, m.cn0_dbhz, carrier_hz(m, st), st});
+        sm_in.push_back(SmoothingInput{m.sat, m.pseudorange_m, m.adr_ok() ? m.adr_m : kNaN, m.pr_rate_mps});
+        spp_obs.push_back(SppObservation{m.sat, m.pseudorange_m, m.cn0_dbhz, carrier_hz(m, st), st});
       }
       CarrierObservation c;
       c.sat = m.sat;
@@ -123,6 +122,16 @@ struct GnssEngine::Impl {
       c.cn0_dbhz = m.cn0_dbhz;
       c.state = st;
       car_obs.push_back(c);
+    }
+    {
+      std::vector<std::string> why;
+      const std::vector<double> sm = smoother.smooth_epoch(sm_in, &why);
+      for (std::size_t i = 0; i < sm.size(); ++i) {
+        spp_obs[i].pseudorange_m = sm[i];
+        if (!why[i].empty()) count(why[i]);
+      }
+      if (smoother.last_common_step_m() != 0.0 && std::fabs(smoother.last_common_step_m()) > 1.0)
+        count("smoothing: common code-carrier step removed (> 1 m)");
     }
     EpochSolution sol;
     sol.t_ns = ep.t_ns;
@@ -209,7 +218,11 @@ struct GnssEngine::Impl {
       have_clock_system = true;
       sol.clock_system = spp.clock_system;
       const bool was_initialized = kf.initialized();
-      const KalmanUpdateResult u = kf.update(spp.pos, spp.pos_cov_ecef, spp.clock_m, spp.clock_var_m2);
+      // R = the SPP covariance scaled by its a-posteriori variance factor chi2/dof (at least 1):
+      // the a-priori C/N0 model does not know the multipath of a moving phone, the residuals do
+      const int dof = static_cast<int>(spp.used.size()) - 4 - static_cast<int>(spp.isb_m.size());
+      const double vf = opt.scale_fix_by_variance_factor && dof > 0 ? std::max(1.0, spp.chi2 / dof) : 1.0;
+      const KalmanUpdateResult u = kf.update(spp.pos, spp.pos_cov_ecef * vf, spp.clock_m, spp.clock_var_m2 * vf);
       sol.kf_update_accepted = u.accepted;
       if (u.accepted) epochs_since_update = 0;
       else count("kf: SPP fix rejected (posterior residual^2/var > 36)");

@@ -32,6 +32,9 @@ struct GnssOptions {
   bool use_doppler_fallback = true;  // pseudorange-rate velocity when TDCP is unavailable
   int lost_after_epochs = 30;        // status kLost after this many epochs without an SPP update
   int min_sats_ok = 6;               // fewer used satellites -> status kDegraded
+  /// Scale the SPP covariance given to the KF by max(1, chi2/dof), the a-posteriori variance
+  /// of unit weight (Teunissen, Adjustment Theory 2003, Sec. 4.3); docs/gnss.md has the effect.
+  bool scale_fix_by_variance_factor = true;
 };
 
 /// One receiver epoch's result.
