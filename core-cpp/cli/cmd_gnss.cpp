@@ -36,6 +36,8 @@ struct GnssArgs {
   bool strip_adr = false;
   double smoothing_window_s = gnss::SmoothingOptions{}.window_s;
   std::uint64_t seed = 1;
+  int keep_every = 1;  // robustness check: keep every N-th epoch (duty cycling)
+  bool clock_steps = false;  // robustness check: a 1 ms code-only clock step every epoch
   double kf_displacement_q_m2 = gnss::KalmanOptions{}.displacement_q_m2;
   double kf_fix_scale = gnss::KalmanOptions{}.fix_variance_scale;
 };
@@ -110,8 +112,12 @@ std::vector<gnss::EpochSolution> run(const GnssArgs& a, gnss::GnssEngine& engine
     gnss::RinexObsReader reader(f, a.log);
     gnss::RinexObsEpoch ep;
     std::map<std::string, std::int64_t> skipped;
+    std::int64_t index = 0;
     while (reader.next(ep)) {
+      if (index++ % a.keep_every != 0) continue;
       auto rows = gnss::rinex_epoch_to_raw(ep, reader.header(), skipped);
+      if (a.clock_steps)
+        for (auto& r : rows) r.full_bias_nanos -= (index % 2) * 1'000'000;
       for (auto& r : rows) {
         if (a.strip_adr) strip(r);
         engine.feed(r);
@@ -130,8 +136,12 @@ std::vector<gnss::EpochSolution> run(const GnssArgs& a, gnss::GnssEngine& engine
   }
   io::LogReader reader(a.log);
   Sample s;
+  std::int64_t index = -1, last_time_nanos = kMissingInt;
   while (reader.next(s)) {
     if (auto* raw = std::get_if<GnssRawSample>(&s)) {
+      if (raw->time_nanos != last_time_nanos) { ++index; last_time_nanos = raw->time_nanos; }
+      if (index % a.keep_every != 0) continue;
+      if (a.clock_steps && raw->full_bias_nanos != kMissingInt) raw->full_bias_nanos -= (index % 2) * 1'000'000;
       ++raw_rows;
       if (a.strip_adr) strip(*raw);
       engine.feed(*raw);
@@ -284,6 +294,10 @@ void register_gnss(CLI::App& app) {
                   "KF process noise added to each displacement, m^2 per epoch")->check(CLI::Range(0.0, 1e6));
   cmd->add_option("--kf-fix-scale", args->kf_fix_scale, "KF: multiplies the SPP covariance used as R")
       ->check(CLI::Range(1e-3, 1e6));
+  cmd->add_option("--keep-every", args->keep_every, "robustness check: keep every N-th epoch (duty cycling)")
+      ->check(CLI::Range(1, 3600));
+  cmd->add_flag("--clock-steps", args->clock_steps,
+                "robustness check: step FullBiasNanos by 1 ms on every other epoch (code moves, carrier does not)");
   cmd->add_option("--seed", args->seed, "engine seed (the engine is deterministic)");
   cmd->callback([args]() { run_gnss(*args); });
 }

@@ -202,7 +202,14 @@ struct GnssEngine::Impl {
 
   void run_filter(const SppSolution& spp, const DisplacementSolution& disp, double dt, EpochSolution& sol) {
     if (kf.initialized()) {
-      if (disp.ok) kf.predict(disp.disp_ecef_m, disp.cov_ecef_m2, disp.clock_change_m, disp.clock_change_var_m2);
+      if (disp.ok) {
+        // the displacement's own covariance plus a process noise growing as dt^3 (white
+        // acceleration, Bar-Shalom 2001 Sec. 6.2): q per 1 s epoch, 125 q over a 5 s gap
+        // (duty cycling: a Doppler velocity times 5 s misses every turn)
+        const double span = std::max(1.0, disp.dt_s > 0.0 ? disp.dt_s : dt);
+        const Eigen::Matrix3d q = Eigen::Matrix3d::Identity() * opt.kalman.displacement_q_m2 * (span * span * span - 1.0);
+        kf.predict(disp.disp_ecef_m, disp.cov_ecef_m2 + q, disp.clock_change_m, disp.clock_change_var_m2);
+      }
       else kf.coast(dt > 0.0 ? dt : 1.0);
     }
     ++epochs_since_update;
