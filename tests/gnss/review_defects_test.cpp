@@ -18,6 +18,7 @@
 #include "pdnav/gnss/solver_synthetic.h"
 #include "pdnav/gnss/sp3.h"
 #include "pdnav/gnss/spp.h"
+#include "pdnav/gnss/tdcp.h"
 #include "pdnav/io/log_reader.h"
 #include "test_data.h"
 
@@ -206,6 +207,72 @@ TEST(ReviewDefects, GsdcSp3With116SatellitesAndPreciseStatesMatchBroadcast) {
   EXPECT_GT(compared, 20);
   EXPECT_TRUE(store.state(SatId{Constellation::kGalileo, 1}, t).has_value());
   EXPECT_FALSE(broadcast.state(SatId{Constellation::kGalileo, 1}, t).has_value());
+}
+
+}  // namespace
+}  // namespace pdnav::gnss
+
+namespace pdnav::gnss {
+namespace {
+
+TEST(ReviewDefects, TdcpDifferencesOnlyTheSameSignal) {
+  const geo::Ecef rx = geo::to_ecef(geo::Geodetic::from_deg(37.4, -122.1, 10.0));
+  auto sky1 = synthetic_sky(rx, 8, 11);
+  auto sky2 = propagate_sky(sky1, 1.0);
+  std::vector<CarrierObservation> e1, e2;
+  for (std::size_t i = 0; i < sky1.size(); ++i) {
+    CarrierObservation a, b;
+    a.sat = b.sat = sky1[i].sat;
+    a.state = sky1[i].state;
+    b.state = sky2[i].state;
+    a.cn0_dbhz = b.cn0_dbhz = 40.0;
+    a.adr_m = sagnac_range_m(a.state.pos.p_m, rx.p_m) - kSpeedOfLight_mps * a.state.clock_bias_s;
+    b.adr_m = sagnac_range_m(b.state.pos.p_m, rx.p_m) - kSpeedOfLight_mps * b.state.clock_bias_s;
+    a.carrier_hz = b.carrier_hz = 1575.42e6;
+    a.code_type = b.code_type = "C";
+    e1.push_back(a);
+    e2.push_back(b);
+  }
+  // satellite 0 switched from E1C to E1B (another code, another ADR origin): not differenced
+  e2[0].code_type = "B";
+  e2[0].adr_m += 1234.5;
+  const DisplacementSolution d = solve_tdcp(e1, e2, 1.0, rx, TdcpOptions{});
+  ASSERT_TRUE(d.ok) << d.reason;
+  EXPECT_EQ(d.used.size(), 7u);
+  EXPECT_EQ(d.excluded.at("tdcp: signal changed between epochs"), 1);
+  EXPECT_LT(d.disp_ecef_m.norm(), 1e-3);
+}
+
+TEST(ReviewDefects, DuplicateSignalsResolvedByUsabilityAndAFixedCodeOrderNotStrength) {
+  // GPS G05 twice in one epoch: the stronger row has no decoded TOW (no code), the weaker is
+  // usable -> the usable one is kept; then two usable rows: code C wins over a stronger X
+  auto make = [](const char* code, double cn0, std::int64_t state) {
+    GnssRawSample r;
+    r.t_ns = 1;
+    r.time_nanos = 1'000'000'000;
+    r.full_bias_nanos = -1'300'000'000'000'000'000;
+    r.bias_nanos = 0.0;
+    r.constellation_type = 1;
+    r.svid = 5;
+    r.state = state;
+    r.cn0_dbhz = cn0;
+    r.code_type = code;
+    r.carrier_frequency_hz = 1575.42e6;
+    const std::int64_t rx = r.time_nanos - r.full_bias_nanos;
+    r.received_sv_time_nanos = (rx - 75'000'000) % (7 * 86400 * kNsPerS);
+    r.pseudorange_rate_mps = 100.0;
+    return r;
+  };
+  const std::int64_t ok = state_bit::kCodeLock | state_bit::kTowDecoded;
+  MeasurementEpoch ep;
+  ExclusionCounts ex;
+  ASSERT_TRUE(build_epoch({make("X", 45.0, state_bit::kCodeLock), make("C", 30.0, ok)}, MeasurementOptions{}, ep, ex));
+  ASSERT_EQ(ep.meas.size(), 1u);
+  EXPECT_TRUE(ep.meas[0].code_ok());
+  ASSERT_TRUE(build_epoch({make("X", 45.0, ok), make("C", 30.0, ok)}, MeasurementOptions{}, ep, ex));
+  ASSERT_EQ(ep.meas.size(), 1u);
+  EXPECT_EQ(ep.meas[0].code_type, "C");
+  EXPECT_EQ(ex.at("signal: duplicate satellite in epoch"), 2);
 }
 
 }  // namespace

@@ -121,6 +121,8 @@ struct GnssEngine::Impl {
       c.pr_rate_sigma_mps = m.pr_rate_sigma_mps;
       c.cn0_dbhz = m.cn0_dbhz;
       c.state = st;
+      c.carrier_hz = m.carrier_hz;
+      c.code_type = m.code_type;
       car_obs.push_back(c);
     }
     {
