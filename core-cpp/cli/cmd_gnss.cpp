@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -17,7 +18,9 @@
 #include <CLI/CLI.hpp>
 
 #include "pdnav/gnss/gnss_engine.h"
+#include "pdnav/gnss/rinex_obs.h"
 #include "pdnav/gnss/solver_metrics.h"
+#include "pdnav/gnss/sp3.h"
 #include "pdnav/io/log_reader.h"
 
 namespace pdnav::cli {
@@ -26,11 +29,17 @@ namespace {
 struct GnssArgs {
   std::string log;
   std::vector<std::string> nav;
+  std::vector<std::string> sp3;
   std::string truth;
+  std::string truth_csv;
   std::string out;
   bool strip_adr = false;
   double smoothing_window_s = gnss::SmoothingOptions{}.window_s;
   std::uint64_t seed = 1;
+  int keep_every = 1;  // robustness check: keep every N-th epoch (duty cycling)
+  bool clock_steps = false;  // robustness check: a 1 ms code-only clock step every epoch
+  double kf_displacement_q_m2 = gnss::KalmanOptions{}.displacement_q_m2;
+  double kf_fix_scale = gnss::KalmanOptions{}.fix_variance_scale;
 };
 
 geo::Geodetic parse_truth(const std::string& s) {
@@ -56,32 +65,100 @@ std::shared_ptr<gnss::EphemerisStore> load_nav(const std::vector<std::string>& f
   return store;
 }
 
-/// Runs the whole log through the engine; returns every epoch solution.
+enum class InputFormat { kLog, kRinexObs };
+
+/// GnssLogger / pdnav session log or RINEX 3 observations, decided from the content; any
+/// other file is an error with the reason.
+InputFormat detect_format(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw std::runtime_error(path + ":0: cannot open");
+  std::string l;
+  int n = 0;
+  while (std::getline(f, l) && n < 50) {
+    ++n;
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+    if (l.find_first_not_of(" \t") == std::string::npos) continue;
+    if (gnss::looks_like_rinex_obs(l)) return InputFormat::kRinexObs;
+    if (l.size() >= 80 && l.substr(60, 20).find("RINEX VERSION / TYPE") == 0)
+      throw std::runtime_error(path + ":" + std::to_string(n) + ": a RINEX file but not observation data ('" +
+                               l.substr(20, 20) + "'); give navigation files with --nav");
+    if (l[0] == '#') return InputFormat::kLog;
+    const auto comma = l.find(',');
+    const std::string type = comma == std::string::npos ? std::string() : l.substr(0, comma);
+    static const char* kTypes[] = {"Raw", "Fix", "Nav", "Status", "Accel", "Gyro", "Mag", "UncalAccel", "UncalGyro",
+                                   "UncalMag", "OrientationDeg", "Agc", "Pressure", "Truth", "Step", "GameRot"};
+    for (const char* t : kTypes) if (type == t) return InputFormat::kLog;
+    throw std::runtime_error(path + ":" + std::to_string(n) +
+                             ": neither a GnssLogger/session log (no '#' header or known line type) nor a RINEX "
+                             "observation file (no RINEX VERSION / TYPE line)");
+  }
+  throw std::runtime_error(path + ":0: empty file (neither a GnssLogger/session log nor RINEX observations)");
+}
+
+void strip(GnssRawSample& raw) {
+  raw.accumulated_delta_range_state = 0;
+  raw.accumulated_delta_range_m = kNaN;
+}
+
+/// Runs the whole input through the engine; returns every epoch solution.
 std::vector<gnss::EpochSolution> run(const GnssArgs& a, gnss::GnssEngine& engine, std::int64_t& raw_rows) {
+  std::vector<gnss::EpochSolution> sols;
+  auto collect = [&]() {
+    auto part = engine.take_solutions();
+    sols.insert(sols.end(), part.begin(), part.end());
+  };
+  if (detect_format(a.log) == InputFormat::kRinexObs) {
+    std::ifstream f(a.log);
+    gnss::RinexObsReader reader(f, a.log);
+    gnss::RinexObsEpoch ep;
+    std::map<std::string, std::int64_t> skipped;
+    std::int64_t index = 0;
+    while (reader.next(ep)) {
+      if (index++ % a.keep_every != 0) continue;
+      auto rows = gnss::rinex_epoch_to_raw(ep, reader.header(), skipped);
+      if (a.clock_steps)
+        for (auto& r : rows) r.full_bias_nanos -= (index % 2) * 1'000'000;
+      for (auto& r : rows) {
+        if (a.strip_adr) strip(r);
+        engine.feed(r);
+      }
+      raw_rows += static_cast<std::int64_t>(rows.size());
+      engine.flush();  // a RINEX epoch is complete when its record ends
+      collect();
+    }
+    const auto& rep = reader.report();
+    std::cout << "rinex obs " << a.log << ": version " << reader.header().version << ", " << rep.epochs << " epochs, "
+              << rep.satellite_records << " satellite records, " << rep.signals << " signals\n";
+    for (const auto& [why, n] : rep.skipped_by_reason) std::cout << "  skipped " << n << ": " << why << "\n";
+    for (const auto& [why, n] : skipped) std::cout << "  skipped " << n << ": " << why << "\n";
+    if (rep.epochs == 0) throw std::runtime_error(a.log + ": RINEX observation file without any epoch");
+    return sols;
+  }
   io::LogReader reader(a.log);
   Sample s;
-  std::vector<gnss::EpochSolution> sols;
+  std::int64_t index = -1, last_time_nanos = kMissingInt;
   while (reader.next(s)) {
     if (auto* raw = std::get_if<GnssRawSample>(&s)) {
+      if (raw->time_nanos != last_time_nanos) { ++index; last_time_nanos = raw->time_nanos; }
+      if (index % a.keep_every != 0) continue;
+      if (a.clock_steps && raw->full_bias_nanos != kMissingInt) raw->full_bias_nanos -= (index % 2) * 1'000'000;
       ++raw_rows;
-      if (a.strip_adr) {
-        raw->accumulated_delta_range_state = 0;
-        raw->accumulated_delta_range_m = kNaN;
-      }
+      if (a.strip_adr) strip(*raw);
       engine.feed(*raw);
     } else if (const auto* nav = std::get_if<NavMessageSample>(&s)) {
       engine.feed(*nav);
     }
-    auto part = engine.take_solutions();
-    sols.insert(sols.end(), part.begin(), part.end());
+    collect();
   }
   engine.flush();
-  auto part = engine.take_solutions();
-  sols.insert(sols.end(), part.begin(), part.end());
+  collect();
   if (reader.stats().skipped_total() > 0) {
     std::cout << "log: skipped " << reader.stats().skipped_total() << " lines\n";
     for (const auto& [why, n] : reader.stats().skipped_by_reason) std::cout << "  " << n << ": " << why << "\n";
   }
+  if (raw_rows == 0)
+    throw std::runtime_error(a.log + ": no Raw GNSS measurement rows in this log (" +
+                             std::to_string(reader.stats().skipped_total()) + " lines skipped)");
   return sols;
 }
 
@@ -150,8 +227,16 @@ void print_accuracy(const gnss::StaticAccuracy& a) {
 
 void run_gnss(const GnssArgs& a) {
   const auto store = load_nav(a.nav);
+  for (const std::string& f : a.sp3) {
+    const gnss::Sp3File sp3 = gnss::read_sp3_file(f);
+    const int n = store->add_precise(sp3);
+    std::printf("sp3 %s: %zu epochs, %d satellites with precise orbits and clocks, %d lines skipped\n", f.c_str(),
+                sp3.epochs.size(), n, sp3.skipped_lines);
+  }
   gnss::GnssOptions options;
   options.smoothing.window_s = a.smoothing_window_s;
+  options.kalman.displacement_q_m2 = a.kf_displacement_q_m2;
+  options.kalman.fix_variance_scale = a.kf_fix_scale;
   gnss::GnssEngine engine(options, store, a.seed);
   std::int64_t raw_rows = 0;
   const std::vector<gnss::EpochSolution> sols = run(a, engine, raw_rows);
@@ -169,6 +254,19 @@ void run_gnss(const GnssArgs& a) {
   }
   const gnss::StaticAccuracy acc = gnss::evaluate_static(sols, truth);
   if (have_truth) print_accuracy(acc);
+  if (!a.truth_csv.empty()) {
+    const gnss::TruthTrack track = gnss::read_truth_csv_file(a.truth_csv);
+    const gnss::TrackAccuracy t = gnss::evaluate_track(sols, track);
+    std::printf("truth track %s: %zu points, %lld rows skipped\n", a.truth_csv.c_str(), track.points.size(),
+                static_cast<long long>(track.skipped_rows));
+    std::printf("%-6s %8s %8s %8s %8s %8s %8s\n", "track", "p50_h_m", "p95_h_m", "rms_h_m", "score_m", "avail", "cov68");
+    for (const auto& [name, st] : {std::pair<const char*, const gnss::TrackStats&>{"SPP", t.spp}, {"KF", t.kf}})
+      std::printf("%-6s %8.2f %8.2f %8.2f %8.2f %8.3f %8.3f   (%d of %d epochs)\n", name, st.p50_h_m, st.p95_h_m,
+                  st.rms_h_m, st.score_m, st.availability, st.coverage68, st.solved, st.epochs);
+    std::printf("track_spp_score_m: %.2f track_spp_avail: %.3f track_kf_score_m: %.2f track_kf_avail: %.3f "
+                "track_kf_cov68: %.3f\n", t.spp.score_m, t.spp.availability, t.kf.score_m, t.kf.availability,
+                t.kf.coverage68);
+  }
   const double nan = kNaN;
   std::printf("spp_p50_h_m: %.2f spp_p95_h_m: %.2f kf_rms_h_m: %.2f tdcp_rms_cm: %.2f\n",
               have_truth ? acc.spp_p50_h_m : nan, have_truth ? acc.spp_p95_h_m : nan,
@@ -180,13 +278,26 @@ void run_gnss(const GnssArgs& a) {
 void register_gnss(CLI::App& app) {
   auto args = std::make_shared<GnssArgs>();
   CLI::App* cmd = app.add_subcommand("gnss", "GNSS engine (SPP, TDCP, robust KF; Walker 2019) on a log's Raw rows");
-  cmd->add_option("log", args->log, "GnssLogger or session log")->required()->check(CLI::ExistingFile);
+  cmd->add_option("log", args->log, "GnssLogger / session log or RINEX 3.0x observation file (detected from the content)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--nav", args->nav, "RINEX navigation files (2 or 3)")->check(CLI::ExistingFile);
+  cmd->add_option("--sp3", args->sp3, "precise orbits and clocks (SP3-c/d); used instead of broadcast where they cover")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--truth", args->truth, "static truth LAT,LON,H (deg, deg, m ellipsoidal)");
+  cmd->add_option("--truth-csv", args->truth_csv,
+                  "per-epoch truth track, GSDC columns millisSinceGpsEpoch,latDeg,lngDeg,heightAboveWgs84EllipsoidM")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "per-epoch CSV (tools/plot.py gnss CSV)");
   cmd->add_flag("--strip-adr", args->strip_adr, "drop carrier phase (tests the Doppler fallback)");
   cmd->add_option("--smoothing-window", args->smoothing_window_s,
                   "carrier smoothing window of the code, s (RTCA DO-229: 100; 0 = raw code)")->check(CLI::Range(0.0, 3600.0));
+  cmd->add_option("--kf-displacement-q", args->kf_displacement_q_m2,
+                  "KF process noise added to each displacement, m^2 per epoch")->check(CLI::Range(0.0, 1e6));
+  cmd->add_option("--kf-fix-scale", args->kf_fix_scale, "KF: multiplies the SPP covariance used as R")
+      ->check(CLI::Range(1e-3, 1e6));
+  cmd->add_option("--keep-every", args->keep_every, "robustness check: keep every N-th epoch (duty cycling)")
+      ->check(CLI::Range(1, 3600));
+  cmd->add_flag("--clock-steps", args->clock_steps,
+                "robustness check: step FullBiasNanos by 1 ms on every other epoch (code moves, carrier does not)");
   cmd->add_option("--seed", args->seed, "engine seed (the engine is deterministic)");
   cmd->callback([args]() { run_gnss(*args); });
 }

@@ -8,3 +8,9 @@ set_tests_properties(gnss.cli_mountainview_bar PROPERTIES LABELS "gnss;cli" TIME
 add_test(NAME gnss.cli_orbits_sp3_bar
   COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/gnss/check_orbits_bar.py" "$<TARGET_FILE:pdnav>" "${PDNAV_SHARED_DATA_DIR}")
 set_tests_properties(gnss.cli_orbits_sp3_bar PROPERTIES LABELS "gnss;cli" TIMEOUT 120)
+
+# Issue 15: `pdnav rinex` output is read by RTKLIB (rnx2rtkp, Debian rtklib) and its single
+# point solution agrees with pdnav's SPP on the same file.
+add_test(NAME gnss.rtklib_reads_pdnav_rinex
+  COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/gnss/check_rtklib_rinex.py" "$<TARGET_FILE:pdnav>" "${PDNAV_SHARED_DATA_DIR}")
+set_tests_properties(gnss.rtklib_reads_pdnav_rinex PROPERTIES LABELS "gnss;cli" TIMEOUT 300)

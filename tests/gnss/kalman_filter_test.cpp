@@ -18,7 +18,10 @@ const Eigen::Matrix3d kFixCov = Eigen::Matrix3d::Identity() * 9.0;  // 3 m per a
 TEST(KalmanFilter, AveragesNoisyFixesWithZeroDisplacement) {
   std::mt19937_64 rng(3);
   std::normal_distribution<double> n3(0.0, 3.0);
-  RobustKalman kf;
+  KalmanOptions white;  // the averaging math: white fix noise, static process noise
+  white.displacement_q_m2 = 1e-4;
+  white.fix_variance_scale = 1.0;
+  RobustKalman kf(white);
   for (int i = 0; i < 200; ++i) {
     if (kf.initialized()) kf.predict(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity() * 1e-6, 0.0, 1e-6);
     const Eigen::Vector3d fix = kTruth.p_m + Eigen::Vector3d(n3(rng), n3(rng), n3(rng));

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "pdnav/gnss/solver_synthetic.h"
+#include "pdnav/gnss/measurements.h"
 #include "pdnav/gnss/spp.h"
 
 namespace pdnav::gnss {
@@ -27,6 +28,7 @@ std::vector<SppObservation> observe(const std::vector<SyntheticSat>& sky, double
     SppObservation o;
     o.sat = s.sat;
     o.cn0_dbhz = 40.0;
+    o.carrier_hz = default_carrier_hz(s.sat.sys);  // B1I for BeiDou (its TGD1 applies)
     o.state = s.state;
     const auto it = isb.find(s.sat.sys);
     o.pseudorange_m = sagnac_range_m(s.state.pos.p_m, kRx.p_m) + clock_m + (it == isb.end() ? 0.0 : it->second) -

@@ -88,7 +88,93 @@ void EphemerisStore::add(const GlonassEphemeris& eph) {
   list.push_back(eph);
 }
 
+int EphemerisStore::add_precise(const Sp3File& sp3) {
+  std::map<SatId, PreciseTrack> tracks;
+  for (const Sp3Epoch& e : sp3.epochs) {
+    for (const auto& [sat, smp] : e.sats) {
+      if (!smp.pos.p_m.allFinite()) continue;
+      PreciseTrack& tr = tracks[sat];
+      if (!tr.t.empty() && e.gps_ns <= tr.t.back()) continue;  // out of order / repeated epoch
+      tr.t.push_back(e.gps_ns);
+      tr.pos_m.push_back(smp.pos.p_m);
+      tr.clock_s.push_back(smp.has_clock && std::isfinite(smp.clock_s) ? smp.clock_s
+                                                                         : std::numeric_limits<double>::quiet_NaN());
+    }
+  }
+  int n = 0;
+  for (auto& [sat, tr] : tracks) {
+    if (static_cast<int>(tr.t.size()) < std::max(2, options_.precise_points)) continue;
+    precise_[sat] = std::move(tr);
+    ++n;
+  }
+  return n;
+}
+
+std::optional<SatState> EphemerisStore::precise_state(const SatId& sat, TimeNs t, std::string* why_not) const {
+  const auto it = precise_.find(sat);
+  if (it == precise_.end()) return refuse(why_not, "no precise orbit");
+  const PreciseTrack& tr = it->second;
+  const int n = static_cast<int>(tr.t.size());
+  const int m = std::min(std::max(2, options_.precise_points), n);
+  if (t < tr.t.front() || t > tr.t.back()) return refuse(why_not, "outside the precise orbit span");
+  const auto hi = std::upper_bound(tr.t.begin(), tr.t.end(), t);
+  int k = static_cast<int>(hi - tr.t.begin());  // tr.t[k-1] <= t < tr.t[k]
+  k = std::clamp(k, 1, n - 1);
+  // a gap (missing epochs) inside the stencil would make the polynomial meaningless
+  int first = std::clamp(k - m / 2, 0, n - m);
+  const double span_s = ns_to_s(tr.t[static_cast<std::size_t>(first + m - 1)] - tr.t[static_cast<std::size_t>(first)]);
+  const double step_s = ns_to_s(tr.t[static_cast<std::size_t>(k)] - tr.t[static_cast<std::size_t>(k - 1)]);
+  if (!(step_s > 0) || span_s > 1.5 * step_s * (m - 1)) return refuse(why_not, "gap in the precise orbit");
+  // Lagrange interpolation of the position at t and t +- 0.5 s (velocity by central difference)
+  auto interp = [&](double dt_s) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    const double x = ns_to_s(t - tr.t[static_cast<std::size_t>(first)]) + dt_s;
+    for (int i = 0; i < m; ++i) {
+      const double xi = ns_to_s(tr.t[static_cast<std::size_t>(first + i)] - tr.t[static_cast<std::size_t>(first)]);
+      double w = 1.0;
+      for (int j = 0; j < m; ++j) {
+        if (j == i) continue;
+        const double xj = ns_to_s(tr.t[static_cast<std::size_t>(first + j)] - tr.t[static_cast<std::size_t>(first)]);
+        w *= (x - xj) / (xi - xj);
+      }
+      p += w * tr.pos_m[static_cast<std::size_t>(first + i)];
+    }
+    return p;
+  };
+  SatState s;
+  s.pos = geo::Ecef(interp(0.0));
+  s.vel_mps = interp(0.5) - interp(-0.5);
+  const double c0 = tr.clock_s[static_cast<std::size_t>(k - 1)], c1 = tr.clock_s[static_cast<std::size_t>(k)];
+  if (!std::isfinite(c0) || !std::isfinite(c1)) return refuse(why_not, "no precise clock");
+  const double f = ns_to_s(t - tr.t[static_cast<std::size_t>(k - 1)]) / step_s;
+  s.clock_drift_sps = (c1 - c0) / step_s;
+  s.clock_bias_s = c0 + f * (c1 - c0) - 2.0 * s.pos.p_m.dot(s.vel_mps) / (kSpeedOfLight_mps * kSpeedOfLight_mps);
+  s.toe_gps_ns = tr.t[static_cast<std::size_t>(k - 1)];
+  s.iode = -1;  // precise
+  std::string ignore;
+  if (const auto b = broadcast_state(sat, t, &ignore)) {
+    s.group_delay_s = b->group_delay_s;
+    s.glonass_channel = b->glonass_channel;
+    s.healthy = b->healthy;
+  }
+  if (!finite_state(s)) return refuse(why_not, "numerical failure");
+  return s;
+}
+
 std::optional<SatState> EphemerisStore::state(const SatId& sat, TimeNs t, std::string* why_not) const {
+  if (options_.prefer_precise && !precise_.empty()) {
+    std::string why;
+    auto p = precise_state(sat, t, &why);
+    if (p) {
+      if (!p->healthy && !options_.accept_unhealthy) return refuse(why_not, "unhealthy");
+      if (why_not) why_not->clear();
+      return p;
+    }
+  }
+  return broadcast_state(sat, t, why_not);
+}
+
+std::optional<SatState> EphemerisStore::broadcast_state(const SatId& sat, TimeNs t, std::string* why_not) const {
   double max_age = 0.0;
   switch (sat.sys) {
     case Constellation::kGps: max_age = options_.gps_max_age_s; break;
@@ -139,6 +225,7 @@ std::vector<SatId> EphemerisStore::satellites() const {
     if (!kv.second.empty()) s.insert(kv.first);
   for (const auto& kv : glonass_)
     if (!kv.second.empty()) s.insert(kv.first);
+  for (const auto& kv : precise_) s.insert(kv.first);
   return {s.begin(), s.end()};
 }
 

@@ -46,6 +46,8 @@ struct GnssEngine::Impl {
   std::int64_t last_gps_ns = 0;
   int epochs_since_update = 0;
   int last_sats_used = 0;
+  bool have_clock_system = false;
+  Constellation kf_clock_system = Constellation::kGps;
   std::string last_reason;
 
   void count(const std::string& reason, std::int64_t n = 1) { excluded[reason] += n; }
@@ -104,14 +106,13 @@ struct GnssEngine::Impl {
     smoother.begin_epoch(has_prev ? dt : 0.0, d_bias_ns * 1e-9 * kSpeedOfLight_mps);
     std::vector<SppObservation> spp_obs;
     std::vector<CarrierObservation> car_obs;
+    std::vector<SmoothingInput> sm_in;
     for (const Measurement& m : ep.meas) {
       SatState st;
       if (!sat_state(m, ep.rx, st)) continue;
       if (m.code_ok()) {
-        std::string why;
-        const double pr = smoother.smooth(SmoothingInput{m.sat, m.pseudorange_m, m.adr_ok() ? m.adr_m : kNaN, m.pr_rate_mps}, &why);
-        if (!why.empty()) count(why);
-        spp_obs.push_back(SppObservation{m.sat, pr, m.cn0_dbhz, carrier_hz(m, st), st});
+        sm_in.push_back(SmoothingInput{m.sat, m.pseudorange_m, m.adr_ok() ? m.adr_m : kNaN, m.pr_rate_mps});
+        spp_obs.push_back(SppObservation{m.sat, m.pseudorange_m, m.cn0_dbhz, carrier_hz(m, st), st});
       }
       CarrierObservation c;
       c.sat = m.sat;
@@ -120,7 +121,19 @@ struct GnssEngine::Impl {
       c.pr_rate_sigma_mps = m.pr_rate_sigma_mps;
       c.cn0_dbhz = m.cn0_dbhz;
       c.state = st;
+      c.carrier_hz = m.carrier_hz;
+      c.code_type = m.code_type;
       car_obs.push_back(c);
+    }
+    {
+      std::vector<std::string> why;
+      const std::vector<double> sm = smoother.smooth_epoch(sm_in, &why);
+      for (std::size_t i = 0; i < sm.size(); ++i) {
+        spp_obs[i].pseudorange_m = sm[i];
+        if (!why[i].empty()) count(why[i]);
+      }
+      if (smoother.last_common_step_m() != 0.0 && std::fabs(smoother.last_common_step_m()) > 1.0)
+        count("smoothing: common code-carrier step removed (> 1 m)");
     }
     EpochSolution sol;
     sol.t_ns = ep.t_ns;
@@ -163,7 +176,15 @@ struct GnssEngine::Impl {
     last_t_ns = ep.t_ns;
     last_gps_ns = ep.rx.ns;
     last_sats_used = sol.sats_used;
+    sol.status = status();
     solutions.push_back(sol);
+  }
+
+  EstimateStatus status() const {
+    if (!kf.initialized()) return EstimateStatus::kNotInitialized;
+    if (epochs_since_update >= opt.lost_after_epochs) return EstimateStatus::kLost;
+    if (epochs_since_update > 0 || last_sats_used < opt.min_sats_ok) return EstimateStatus::kDegraded;
+    return EstimateStatus::kOk;
   }
 
   DisplacementSolution displacement(const std::vector<CarrierObservation>& obs, double dt) {
@@ -183,13 +204,34 @@ struct GnssEngine::Impl {
 
   void run_filter(const SppSolution& spp, const DisplacementSolution& disp, double dt, EpochSolution& sol) {
     if (kf.initialized()) {
-      if (disp.ok) kf.predict(disp.disp_ecef_m, disp.cov_ecef_m2, disp.clock_change_m, disp.clock_change_var_m2);
+      if (disp.ok) {
+        // the displacement's own covariance plus a process noise growing as dt^3 (white
+        // acceleration, Bar-Shalom 2001 Sec. 6.2): q per 1 s epoch, 125 q over a 5 s gap
+        // (duty cycling: a Doppler velocity times 5 s misses every turn)
+        const double span = std::max(1.0, disp.dt_s > 0.0 ? disp.dt_s : dt);
+        const Eigen::Matrix3d q = Eigen::Matrix3d::Identity() * opt.kalman.displacement_q_m2 * (span * span * span - 1.0);
+        kf.predict(disp.disp_ecef_m, disp.cov_ecef_m2 + q, disp.clock_change_m, disp.clock_change_var_m2);
+      }
       else kf.coast(dt > 0.0 ? dt : 1.0);
     }
     ++epochs_since_update;
     if (spp.ok) {
+      // the SPP clock is the clock of its reference system (GPS when present); when that
+      // system changes, the clock state jumps by an ISB: re-initialise the clock instead of
+      // rejecting updates until the filter hard-resets
+      if (kf.initialized() && have_clock_system && spp.clock_system != kf_clock_system) {
+        count("kf: reference clock system changed (clock re-initialised)");
+        kf.reset_clock(spp.clock_m, 1e12);
+      }
+      kf_clock_system = spp.clock_system;
+      have_clock_system = true;
+      sol.clock_system = spp.clock_system;
       const bool was_initialized = kf.initialized();
-      const KalmanUpdateResult u = kf.update(spp.pos, spp.pos_cov_ecef, spp.clock_m, spp.clock_var_m2);
+      // R = the SPP covariance scaled by its a-posteriori variance factor chi2/dof (at least 1):
+      // the a-priori C/N0 model does not know the multipath of a moving phone, the residuals do
+      const int dof = static_cast<int>(spp.used.size()) - 4 - static_cast<int>(spp.isb_m.size());
+      const double vf = opt.scale_fix_by_variance_factor && dof > 0 ? std::max(1.0, spp.chi2 / dof) : 1.0;
+      const KalmanUpdateResult u = kf.update(spp.pos, spp.pos_cov_ecef * vf, spp.clock_m, spp.clock_var_m2 * vf);
       sol.kf_update_accepted = u.accepted;
       if (u.accepted) epochs_since_update = 0;
       else count("kf: SPP fix rejected (posterior residual^2/var > 36)");
@@ -225,6 +267,22 @@ void GnssEngine::feed(const GnssRawSample& s) {
   m.pending.push_back(s);
 }
 
+void GnssEngine::feed_epoch(const std::vector<GnssRawSample>& rows) {
+  flush();
+  Impl& m = *impl_;
+  std::vector<GnssRawSample> ok;
+  ok.reserve(rows.size());
+  for (const GnssRawSample& r : rows) {
+    if (r.time_nanos == kMissingInt) { m.count("row: TimeNanos missing"); continue; }
+    if (!ok.empty() && r.time_nanos != ok.front().time_nanos) {  // not one epoch after all
+      m.process(ok);
+      ok.clear();
+    }
+    ok.push_back(r);
+  }
+  if (!ok.empty()) m.process(ok);
+}
+
 void GnssEngine::feed(const NavMessageSample& s) {
   Impl& m = *impl_;
   if (s.type != kGpsL1CaNavType) { m.count("nav: unsupported message type"); return; }
@@ -253,6 +311,7 @@ void GnssEngine::reset() {
   m.has_prev = false;
   m.have_pos = false;
   m.epochs_since_update = 0;
+  m.have_clock_system = false;
 }
 
 Estimate GnssEngine::estimate() const {

@@ -136,14 +136,29 @@ bool l1_band(Constellation sys, double carrier_hz) {
   return std::fabs(carrier_hz - 1575.42e6) < 10e6;
 }
 
-/// Keeps one signal per satellite (the strongest), counting the others.
+/// Preference among two signals of one satellite in the same band: usable code first, then
+/// usable carrier, then a fixed order of tracking codes (pilot/data-pilot before data: C, X, I, Q,
+/// P, B ...; the same choice every epoch, so smoothing and TDCP stay on one signal), C/N0 last.
+bool better_signal(const Measurement& a, const Measurement& b) {
+  if (a.code_ok() != b.code_ok()) return a.code_ok();
+  if (a.adr_ok() != b.adr_ok()) return a.adr_ok();
+  static const std::string kOrder = "CXIQPBDLSZAMNW";
+  auto rank = [](const std::string& c) {
+    const auto p = c.empty() ? std::string::npos : kOrder.find(c[0]);
+    return p == std::string::npos ? kOrder.size() : p;
+  };
+  if (rank(a.code_type) != rank(b.code_type)) return rank(a.code_type) < rank(b.code_type);
+  return a.cn0_dbhz > b.cn0_dbhz;
+}
+
+/// Keeps one signal per satellite (better_signal), counting the others.
 void drop_duplicates(std::vector<Measurement>& meas, ExclusionCounts& excluded) {
   std::vector<Measurement> out;
   for (const Measurement& m : meas) {
     auto it = std::find_if(out.begin(), out.end(), [&](const Measurement& o) { return o.sat == m.sat; });
     if (it == out.end()) { out.push_back(m); continue; }
     ++excluded["signal: duplicate satellite in epoch"];
-    if (m.cn0_dbhz > it->cn0_dbhz) *it = m;
+    if (better_signal(m, *it)) *it = m;
   }
   meas.swap(out);
 }
@@ -221,6 +236,7 @@ bool build_epoch(const std::vector<GnssRawSample>& rows, const MeasurementOption
     m.cn0_dbhz = r.cn0_dbhz;
     if (m.sat.sys == Constellation::kGlonass && r.svid >= 93 && r.svid <= 106) m.glonass_channel = r.svid - 100;
     if (finite_and_small(r.carrier_frequency_hz, 1e10) && r.carrier_frequency_hz > 1e8) m.carrier_hz = r.carrier_frequency_hz;
+    if (r.code_type.size() <= 4) m.code_type = r.code_type;
     if (!l1_band(m.sat.sys, m.carrier_hz)) { ++excluded["signal: not L1/E1/B1 (one band used)"]; continue; }
     // TimeOffsetNanos is per measurement, so each row has its own receive time
     GpsTime rx;

@@ -2,6 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+
+#include "pdnav/geo/time.h"
 
 namespace pdnav::gnss {
 namespace {
@@ -66,6 +73,130 @@ StaticAccuracy evaluate_static(const std::vector<EpochSolution>& sols, const geo
   a.kf_rms_v_m = rms(kf_v);
   a.tdcp_rms_enu_m = rms_axes(tdcp);
   a.doppler_rms_enu_m = rms_axes(dopp);
+  return a;
+}
+
+namespace {
+
+std::vector<std::string> split_csv(const std::string& l) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : l) {
+    if (c == ',') { out.push_back(cur); cur.clear(); }
+    else if (c != '\r' && c != '"') cur += c;
+  }
+  out.push_back(cur);
+  for (auto& f : out) {
+    const auto b = f.find_first_not_of(" \t");
+    f = b == std::string::npos ? std::string() : f.substr(b, f.find_last_not_of(" \t") - b + 1);
+  }
+  return out;
+}
+
+bool to_double(const std::string& f, double& v) {
+  if (f.empty() || f.size() > 64) return false;
+  char* end = nullptr;
+  v = std::strtod(f.c_str(), &end);
+  return end && *end == '\0' && std::isfinite(v);
+}
+
+}  // namespace
+
+TruthTrack read_truth_csv(std::istream& in, const std::string& name) {
+  std::string l;
+  int line_no = 0;
+  auto fail = [&](const std::string& why) { throw std::runtime_error(name + ":" + std::to_string(line_no) + ": " + why); };
+  if (!std::getline(in, l)) fail("empty truth file");
+  ++line_no;
+  const auto head = split_csv(l);
+  const char* want[4] = {"millisSinceGpsEpoch", "latDeg", "lngDeg", "heightAboveWgs84EllipsoidM"};
+  int col[4] = {-1, -1, -1, -1};
+  for (int k = 0; k < 4; ++k)
+    for (std::size_t i = 0; i < head.size(); ++i)
+      if (head[i] == want[k]) col[k] = static_cast<int>(i);
+  for (int k = 0; k < 4; ++k)
+    if (col[k] < 0) fail(std::string("truth CSV: no column '") + want[k] + "' in the header");
+  TruthTrack t;
+  while (std::getline(in, l)) {
+    ++line_no;
+    if (l.empty() || l == "\r") continue;
+    const auto f = split_csv(l);
+    double v[4];
+    bool ok = true;
+    for (int k = 0; k < 4 && ok; ++k)
+      ok = static_cast<std::size_t>(col[k]) < f.size() && to_double(f[static_cast<std::size_t>(col[k])], v[k]);
+    if (!ok || std::fabs(v[1]) > 90.0 || std::fabs(v[2]) > 180.0 || std::fabs(v[3]) > 1e5 || v[0] < 0 || v[0] > 1e14) {
+      ++t.skipped_rows;
+      continue;
+    }
+    TruthPoint p;
+    p.gps_ns = static_cast<std::int64_t>(std::llround(v[0])) * kNsPerMs;
+    p.pos = geo::Geodetic::from_deg(v[1], v[2], v[3]);
+    t.points.push_back(p);
+  }
+  if (t.points.empty()) fail("truth CSV: no usable row");
+  std::stable_sort(t.points.begin(), t.points.end(), [](const TruthPoint& a, const TruthPoint& b) { return a.gps_ns < b.gps_ns; });
+  return t;
+}
+
+TruthTrack read_truth_csv_file(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw std::runtime_error(path + ":0: cannot open");
+  return read_truth_csv(f, path);
+}
+
+bool truth_at(const TruthTrack& t, std::int64_t gps_ns, geo::Geodetic& out, double max_gap_s) {
+  const auto& p = t.points;
+  if (p.empty()) return false;
+  auto it = std::lower_bound(p.begin(), p.end(), gps_ns, [](const TruthPoint& a, std::int64_t x) { return a.gps_ns < x; });
+  const double tol_ns = 2e6;  // 2 ms: a point this close is used as is
+  if (it != p.end() && std::fabs(static_cast<double>(it->gps_ns - gps_ns)) <= tol_ns) { out = it->pos; return true; }
+  if (it != p.begin() && std::fabs(static_cast<double>(std::prev(it)->gps_ns - gps_ns)) <= tol_ns) { out = std::prev(it)->pos; return true; }
+  if (it == p.begin() || it == p.end()) return false;
+  const TruthPoint& a = *std::prev(it);
+  const TruthPoint& b = *it;
+  const double span = static_cast<double>(b.gps_ns - a.gps_ns);
+  if (!(span > 0) || span * 1e-9 > max_gap_s) return false;
+  const double f = static_cast<double>(gps_ns - a.gps_ns) / span;
+  const Eigen::Vector3d ea = geo::to_ecef(a.pos).p_m, eb = geo::to_ecef(b.pos).p_m;
+  out = geo::to_geodetic(geo::Ecef(ea + f * (eb - ea)));
+  return true;
+}
+
+TrackAccuracy evaluate_track(const std::vector<EpochSolution>& sols, const TruthTrack& truth) {
+  std::vector<double> spp_h, kf_h;
+  int epochs = 0, inside = 0;
+  for (const EpochSolution& s : sols) {
+    geo::Geodetic g;
+    if (!truth_at(truth, s.gps_ns, g)) continue;
+    ++epochs;
+    const geo::LocalFrame frame(g);
+    if (s.spp_ok) {
+      const geo::Enu e = frame.to_enu(s.spp);
+      spp_h.push_back(std::hypot(e.e_m(), e.n_m()));
+    }
+    if (s.kf_ok) {
+      const geo::Enu e = frame.to_enu(s.kf);
+      kf_h.push_back(std::hypot(e.e_m(), e.n_m()));
+      const Eigen::Matrix2d c = s.kf_cov_enu.topLeftCorner<2, 2>();
+      const Eigen::Vector2d d(e.e_m(), e.n_m());
+      const double det = c.determinant();
+      if (det > 0) inside += d.dot(c.inverse() * d) <= 2.279;
+    }
+  }
+  auto fill = [&](TrackStats& t, const std::vector<double>& h) {
+    t.epochs = epochs;
+    t.solved = static_cast<int>(h.size());
+    t.p50_h_m = percentile(h, 50.0);
+    t.p95_h_m = percentile(h, 95.0);
+    t.rms_h_m = rms(h);
+    t.score_m = 0.5 * (t.p50_h_m + t.p95_h_m);
+    t.availability = epochs > 0 ? static_cast<double>(h.size()) / epochs : kNaN;
+  };
+  TrackAccuracy a;
+  fill(a.spp, spp_h);
+  fill(a.kf, kf_h);
+  a.kf.coverage68 = kf_h.empty() ? kNaN : static_cast<double>(inside) / static_cast<double>(kf_h.size());
   return a;
 }
 

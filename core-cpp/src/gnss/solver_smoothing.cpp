@@ -12,6 +12,42 @@ void CodeSmoother::begin_epoch(double dt_s, double clock_jump_m) {
   if (!(dt_s > 0.0)) sats_.clear();
 }
 
+double CodeSmoother::innovation(const SmoothingInput& in) const {
+  if (!std::isfinite(in.pseudorange_m)) return std::nan("");
+  const auto it = sats_.find(in.sat);
+  if (it == sats_.end()) return std::nan("");
+  const Sat& s = it->second;
+  if (!(s.epoch == epoch_ - 1 && dt_s_ > 0.0 && opt_.window_s > 0.0)) return std::nan("");
+  double delta = std::nan("");
+  if (std::isfinite(in.adr_m) && std::isfinite(s.adr_m)) delta = in.adr_m - s.adr_m - clock_jump_m_;
+  else if (std::isfinite(in.pr_rate_mps) && std::isfinite(s.pr_rate_mps))
+    delta = 0.5 * (in.pr_rate_mps + s.pr_rate_mps) * dt_s_ - clock_jump_m_;
+  return in.pseudorange_m - (s.pr_sm_m + delta);
+}
+
+std::vector<double> CodeSmoother::smooth_epoch(const std::vector<SmoothingInput>& in, std::vector<std::string>* reasons) {
+  common_step_m_ = 0.0;
+  if (opt_.remove_common_step) {
+    std::vector<double> d;
+    for (const auto& x : in) {
+      const double v = innovation(x);
+      if (std::isfinite(v)) d.push_back(v);
+    }
+    if (static_cast<int>(d.size()) >= std::max(1, opt_.min_sats_common_step)) {
+      std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+      common_step_m_ = d[d.size() / 2];
+    }
+  }
+  const double saved = clock_jump_m_;
+  clock_jump_m_ -= common_step_m_;  // the step moves the code: add it to every propagation
+  std::vector<double> out;
+  out.reserve(in.size());
+  if (reasons) reasons->assign(in.size(), std::string());
+  for (std::size_t i = 0; i < in.size(); ++i) out.push_back(smooth(in[i], reasons ? &(*reasons)[i] : nullptr));
+  clock_jump_m_ = saved;
+  return out;
+}
+
 double CodeSmoother::smooth(const SmoothingInput& in, std::string* reason) {
   if (!std::isfinite(in.pseudorange_m)) return in.pseudorange_m;
   Sat& s = sats_[in.sat];

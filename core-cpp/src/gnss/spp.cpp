@@ -22,9 +22,17 @@ struct Layout {
   int cols = 4;
 };
 
+}  // namespace
+
+Constellation clock_group(Constellation sys) {
+  return sys == Constellation::kQzss ? Constellation::kGps : sys;
+}
+
+namespace {
+
 Layout make_layout(const std::vector<const SppObservation*>& obs) {
   std::map<Constellation, int> count;
-  for (const auto* o : obs) ++count[o->sat.sys];
+  for (const auto* o : obs) ++count[clock_group(o->sat.sys)];
   Layout l;
   l.ref = count.count(Constellation::kGps) ? Constellation::kGps : count.begin()->first;
   for (const auto& [sys, n] : count) {
@@ -34,6 +42,11 @@ Layout make_layout(const std::vector<const SppObservation*>& obs) {
   return l;
 }
 
+int isb_col(const Layout& l, Constellation sys) {
+  const Constellation g = clock_group(sys);
+  return g == l.ref ? -1 : l.isb_col.at(g);
+}
+
 struct Row {
   double residual_m = 0.0;   // measured - modelled
   Eigen::Vector3d los = Eigen::Vector3d::Zero();  // unit vector receiver -> satellite
@@ -41,6 +54,18 @@ struct Row {
   double el_rad = kPi / 2;
   bool masked = false;
 };
+
+/// Broadcast group delay for this signal. GPS/QZSS L1 C/A: TGD; L5: (f1/f5)^2 TGD (IS-GPS-200
+/// 20.3.3.3.3.2 scaling, the ISC_L5 of CNAV is not in RINEX 3 LNAV). Galileo: BGD scaled the same
+/// way for E5a. BeiDou: TGD1 is the B1I delay (BDS-SIS-ICD-B1I 5.2.4.10); it must not be applied
+/// to B1C (1575.42 MHz), whose TGD_B1Cp is only in CNAV1 (not in RINEX 3 nav), so B1C gets none.
+double signal_group_delay_s(const SppObservation& o) {
+  const double g = o.state.group_delay_s;
+  if (o.sat.sys == Constellation::kGlonass) return 0.0;
+  if (o.sat.sys == Constellation::kBeidou) return std::fabs(o.carrier_hz - 1561.098e6) < 1e6 ? g : 0.0;
+  if (std::fabs(o.carrier_hz - kL1Hz) < 1e6) return g;
+  return g * (kL1Hz / o.carrier_hz) * (kL1Hz / o.carrier_hz);
+}
 
 /// Model of one pseudorange at the iterate x (ECEF + clocks).
 Row model_row(const SppObservation& o, const Eigen::VectorXd& x, const Layout& l, double tow_s,
@@ -55,7 +80,7 @@ Row model_row(const SppObservation& o, const Eigen::VectorXd& x, const Layout& l
   }
   r.los = (sat - rx) / range;
   double clock = x(3);
-  if (o.sat.sys != l.ref) clock += x(l.isb_col.at(o.sat.sys));
+  if (isb_col(l, o.sat.sys) >= 0) clock += x(isb_col(l, o.sat.sys));
   double atmo_m = 0.0;
   const double radius = rx.norm();
   if (radius > kNearSurfaceMinM && radius < kNearSurfaceMaxM) {
@@ -70,7 +95,7 @@ Row model_row(const SppObservation& o, const Eigen::VectorXd& x, const Layout& l
     }
     if (opt.troposphere && ae.el_rad > 0.0) atmo_m += saastamoinen_delay_m(g, ae.el_rad);
   }
-  const double sat_clock_m = kSpeedOfLight_mps * (o.state.clock_bias_s - o.state.group_delay_s);
+  const double sat_clock_m = kSpeedOfLight_mps * (o.state.clock_bias_s - signal_group_delay_s(o));
   r.residual_m = o.pseudorange_m - (range + clock - sat_clock_m + atmo_m);
   r.var_m2 = cn0_elevation_variance(opt.code_var_a_m2, opt.code_var_b_m2, o.cn0_dbhz, r.el_rad);
   return r;
@@ -101,7 +126,7 @@ LsResult iterate_ls(const std::vector<const SppObservation*>& obs, const Layout&
       if (r.masked) continue;
       h.block<1, 3>(i, 0) = -r.los.transpose();
       h(i, 3) = 1.0;
-      if (obs[i]->sat.sys != l.ref) h(i, l.isb_col.at(obs[i]->sat.sys)) = 1.0;
+      if (isb_col(l, obs[i]->sat.sys) >= 0) h(i, isb_col(l, obs[i]->sat.sys)) = 1.0;
       y(i) = r.residual_m;
       w(i) = 1.0 / r.var_m2;
       ++used;
@@ -137,14 +162,14 @@ Eigen::VectorXd initial_state(const Layout& l, const geo::Ecef& initial) {
 std::vector<const SppObservation*> usable(const std::vector<SppObservation>& obs, const SppOptions& opt,
                                           std::map<std::string, std::int64_t>& excluded) {
   std::map<Constellation, int> count;
-  for (const auto& o : obs) ++count[o.sat.sys];
+  for (const auto& o : obs) ++count[clock_group(o.sat.sys)];
   std::vector<const SppObservation*> out;
   for (const auto& o : obs) {
     if (!std::isfinite(o.pseudorange_m) || !o.state.pos.p_m.allFinite() || !std::isfinite(o.cn0_dbhz)) {
       ++excluded["spp: non-finite input"];
       continue;
     }
-    if (opt.drop_single_sat_systems && count[o.sat.sys] == 1 && count.size() > 1) {
+    if (opt.drop_single_sat_systems && count[clock_group(o.sat.sys)] == 1 && count.size() > 1) {
       ++excluded["spp: single satellite of its system"];
       continue;
     }
@@ -162,7 +187,7 @@ bool fill_dop(const LsResult& ls, const std::vector<const SppObservation*>& obs,
     if (r.masked) continue;
     h.block<1, 3>(k, 0) = -r.los.transpose();
     h(k, 3) = 1.0;
-    if (obs[i]->sat.sys != l.ref) h(k, l.isb_col.at(obs[i]->sat.sys)) = 1.0;
+    if (isb_col(l, obs[i]->sat.sys) >= 0) h(k, isb_col(l, obs[i]->sat.sys)) = 1.0;
     ++k;
   }
   const Eigen::MatrixXd n_mat = h.topRows(k).transpose() * h.topRows(k);
@@ -295,7 +320,12 @@ SppSolution solve_spp(const std::vector<SppObservation>& all, const geo::Ecef& i
     if (!test_fails || static_cast<int>(fde.size()) >= opt.max_fde_exclusions || dof < 2) {
       s.excluded = excluded;
       s.excluded_fde = fde;
-      if (test_fails) s.reason = "residual test failed after exclusions";
+      if (test_fails) {
+        // no consistent subset was found: the fix cannot be trusted (counted by the caller)
+        s.ok = false;
+        s.reason = dof < 2 ? "residual test failed, too few satellites to exclude"
+                           : "residual test failed after exclusions";
+      }
       return s;
     }
     const std::size_t worst = worst_satellite(ls);

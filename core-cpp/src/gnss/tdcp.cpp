@@ -118,6 +118,7 @@ DisplacementSolution solve_tdcp(const std::vector<CarrierObservation>& epoch1,
     const auto it = first.find(o2.sat);
     if (it == first.end() || !std::isfinite(o2.adr_m) || !std::isfinite(it->second->adr_m)) continue;
     const CarrierObservation& o1 = *it->second;
+    if (!same_signal(o1, o2)) { ++ex["tdcp: signal changed between epochs"]; continue; }
     const double adr_rate = (o2.adr_m - o1.adr_m) / dt_s;
     if (std::isfinite(o1.pr_rate_mps) && std::isfinite(o2.pr_rate_mps) &&
         std::fabs(adr_rate - 0.5 * (o1.pr_rate_mps + o2.pr_rate_mps)) > opt.max_rate_mismatch_mps) {
@@ -167,6 +168,13 @@ DisplacementSolution solve_doppler(const std::vector<CarrierObservation>& epoch,
   }
   const WlsOut w = robust_wls(rows, opt, ex, "doppler: FDE residual test");
   return finish(w, "doppler", dt_s, dt_s, ex);
+}
+
+bool same_signal(const CarrierObservation& a, const CarrierObservation& b) {
+  if (std::isfinite(a.carrier_hz) && std::isfinite(b.carrier_hz) && std::fabs(a.carrier_hz - b.carrier_hz) > 1e3)
+    return false;
+  if (std::isfinite(a.carrier_hz) != std::isfinite(b.carrier_hz)) return false;
+  return a.code_type.empty() || b.code_type.empty() || a.code_type == b.code_type;
 }
 
 }  // namespace pdnav::gnss

@@ -23,6 +23,7 @@
 #include "pdnav/geo/samples.h"
 #include "pdnav/geo/units.h"
 #include "pdnav/gnss/atmosphere.h"
+#include "pdnav/gnss/sp3.h"
 #include "pdnav/gnss/types.h"
 
 namespace pdnav::gnss {
@@ -101,6 +102,13 @@ struct EphemerisStoreOptions {
   double qzss_max_age_s = 2 * 3600.0;
   double glonass_max_age_s = 30 * 60.0;
   bool accept_unhealthy = false;
+  // Precise orbits (add_precise): Lagrange interpolation over `precise_points` SP3 epochs
+  // (10 points = degree 9, the usual choice for 15-min IGS orbits (Schenewerk 2003); with
+  // 5-min products the error is well below 1 mm); clocks by linear interpolation between
+  // the two neighbouring epochs (5-min clocks: the IGS/RINEX CLK convention). Used only
+  // inside the SP3 span with a full stencil; otherwise the broadcast ephemeris.
+  int precise_points = 10;
+  bool prefer_precise = true;
 };
 
 class EphemerisStore {
@@ -116,6 +124,16 @@ class EphemerisStore {
 
   void add(const KeplerEphemeris& eph);
   void add(const GlonassEphemeris& eph);
+
+  /// Precise orbits and clocks (SP3, e.g. CODE MGEX) for every satellite the file has.
+  /// Conventions (docs/gnss-orbits.md): SP3 positions are the centre of mass and are used
+  /// as the antenna position (no phase-centre offset; its line-of-sight effect is common to
+  /// all satellites to a few cm); the SP3 clock gets the periodic relativistic correction
+  /// -2 r.v / c^2 added (SP3 clocks exclude it) and the broadcast group delay (TGD / BGD)
+  /// of the same satellite when a broadcast record is loaded, else 0 (the SP3 clock refers
+  /// to the ionosphere-free combination). Returns the number of satellites added.
+  int add_precise(const Sp3File& sp3);
+  bool has_precise() const { return !precise_.empty(); }
 
   /// One GnssLogger `Nav` row of GPS L1 C/A (type 0x0101): `svid` (PRN), `subframe_id`
   /// (Sub-messageId, 1..5) and the 40 data bytes (10 words of 30 bits, each in 32 bits,
@@ -156,6 +174,14 @@ class EphemerisStore {
   std::map<SatId, std::vector<GlonassEphemeris>> glonass_;
   std::map<int, LnavBuffer> lnav_;
   std::optional<KlobucharParams> klobuchar_;
+  struct PreciseTrack {
+    std::vector<TimeNs> t;                 // epochs (GPS time, sorted)
+    std::vector<Eigen::Vector3d> pos_m;
+    std::vector<double> clock_s;           // NaN when the epoch has no clock
+  };
+  std::map<SatId, PreciseTrack> precise_;
+  std::optional<SatState> precise_state(const SatId& sat, TimeNs t, std::string* why_not) const;
+  std::optional<SatState> broadcast_state(const SatId& sat, TimeNs t, std::string* why_not) const;
 };
 
 /// Broadcast Keplerian state at GPS time t (no health/staleness checks).

@@ -32,6 +32,9 @@ struct GnssOptions {
   bool use_doppler_fallback = true;  // pseudorange-rate velocity when TDCP is unavailable
   int lost_after_epochs = 30;        // status kLost after this many epochs without an SPP update
   int min_sats_ok = 6;               // fewer used satellites -> status kDegraded
+  /// Scale the SPP covariance given to the KF by max(1, chi2/dof), the a-posteriori variance
+  /// of unit weight (Teunissen, Adjustment Theory 2003, Sec. 4.3); docs/gnss.md has the effect.
+  bool scale_fix_by_variance_factor = true;
 };
 
 /// One receiver epoch's result.
@@ -55,6 +58,10 @@ struct EpochSolution {
   int sats_used = 0;                        // in SPP
   int sats_tracked = 0;                     // rows of the epoch
   std::map<Constellation, int> used_by_sys;
+  Constellation clock_system = Constellation::kGps;  // reference system of the SPP clock
+  /// The engine status after this epoch (what estimate() returns then): kOk, kDegraded (coasting
+  /// or fewer than min_sats_ok satellites; still a usable position), kLost, kNotInitialized.
+  EstimateStatus status = EstimateStatus::kNotInitialized;
 };
 
 class GnssEngine {
@@ -66,8 +73,12 @@ class GnssEngine {
   GnssEngine(GnssEngine&&) noexcept;
   GnssEngine& operator=(GnssEngine&&) noexcept;
 
-  /// Rows of one epoch share TimeNanos; an epoch is processed when the next one starts.
+  /// Rows of one epoch share TimeNanos; an epoch is processed when the next one starts, or
+  /// at once by flush() when the caller knows the epoch is complete (a GnssMeasurementsEvent,
+  /// the end of a RINEX epoch, the first non-Raw line after Raw lines of a log).
   void feed(const GnssRawSample& s);
+  /// All rows of one epoch (one GnssMeasurementsEvent): processed immediately, no latency.
+  void feed_epoch(const std::vector<GnssRawSample>& rows);
   /// GPS LNAV subframes (type 0x0101) go into the engine's own copy of the ephemeris store.
   void feed(const NavMessageSample& s);
   /// Process the pending epoch.

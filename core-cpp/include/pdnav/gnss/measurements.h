@@ -64,6 +64,7 @@ struct Measurement {
   bool adr_cycle_slip = false;          // ADR_STATE_CYCLE_SLIP
   double cn0_dbhz = kNaN;
   double carrier_hz = kNaN;             // CarrierFrequencyHz, or NaN (use default_carrier_hz)
+  std::string code_type;                // GnssMeasurement CodeType ("C", "Q", "X", ...), "" unknown
   int glonass_channel = 99;             // FDMA channel from an Android svid 93..106, 99 = unknown
   bool code_ok() const { return pseudorange_m == pseudorange_m; }
   bool adr_ok() const { return adr_m == adr_m && !adr_reset && !adr_cycle_slip; }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "pdnav/gnss/types.h"
 
@@ -14,6 +15,12 @@ namespace pdnav::gnss {
 struct SmoothingOptions {
   double window_s = 100.0;          // RTCA DO-229 (100 s); 0 disables smoothing
   double max_jump_m = 60.0;         // |code - propagated| above this restarts the satellite (slip / code error)
+  /// Remove the epoch's common code-minus-carrier step (median over satellites) before the
+  /// per-satellite test: a receiver clock step that moves the code but not the carrier (an
+  /// Android FullBiasNanos/BiasNanos step, a RINEX file whose phase is on another clock, a
+  /// clock discontinuity) is common to all satellites; a slip or multipath is not.
+  bool remove_common_step = true;
+  int min_sats_common_step = 4;     // fewer continuous satellites: no common-step estimate
 };
 
 /// One satellite's inputs at an epoch (NaN when missing).
@@ -34,6 +41,12 @@ class CodeSmoother {
   /// Smoothed pseudorange of one satellite at this epoch; `reason` is set when it restarted
   /// for a reason worth counting ("code-carrier jump").
   double smooth(const SmoothingInput& in, std::string* reason = nullptr);
+  /// All satellites of the epoch at once (after begin_epoch): with remove_common_step the
+  /// median code-minus-propagation step is removed first. Returns one value per input;
+  /// `reasons` (optional) gets one entry per input ("" when nothing to count).
+  std::vector<double> smooth_epoch(const std::vector<SmoothingInput>& in, std::vector<std::string>* reasons = nullptr);
+  /// The common step removed at the last smooth_epoch (m), 0 when none.
+  double last_common_step_m() const { return common_step_m_; }
   void reset() { sats_.clear(); }
 
  private:
@@ -47,6 +60,9 @@ class CodeSmoother {
   std::int64_t epoch_ = 0;
   double dt_s_ = 0.0;
   double clock_jump_m_ = 0.0;
+  double common_step_m_ = 0.0;
+  /// code - propagated for a continuous satellite, NaN otherwise
+  double innovation(const SmoothingInput& in) const;
 };
 
 }  // namespace pdnav::gnss

@@ -77,6 +77,10 @@ struct SppSolution {
 SppSolution solve_spp(const std::vector<SppObservation>& obs, const geo::Ecef& initial,
                       double gps_tow_s, const KlobucharParams* klob, const SppOptions& opt);
 
+/// The receiver-clock group of a system: QZSS shares GPS time (IS-QZSS-PNT 3.2: QZSST is
+/// steered to GPST and L1 C/A is interoperable), every other system has its own ISB.
+Constellation clock_group(Constellation sys);
+
 /// Sagnac (Earth rotation during signal travel) correction: the satellite position of the
 /// transmit instant expressed in the ECEF frame of the receive instant.
 Eigen::Vector3d rotate_for_travel_time(const Eigen::Vector3d& sat_ecef_m, double travel_s);

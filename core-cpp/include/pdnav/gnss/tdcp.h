@@ -39,7 +39,13 @@ struct CarrierObservation {
   double pr_rate_sigma_mps = kNaN;
   double cn0_dbhz = 0.0;
   SatState state;                      // at this epoch's transmit time
+  double carrier_hz = kNaN;            // signal identity: TDCP differences only the same signal
+  std::string code_type;               // tracking code ("C", "X", ...), "" when unknown
 };
+
+/// True when two observations are of the same signal (carrier within 1 kHz when both known,
+/// same tracking code when both known); TDCP across a signal change is meaningless.
+bool same_signal(const CarrierObservation& a, const CarrierObservation& b);
 
 struct DisplacementSolution {
   bool ok = false;
