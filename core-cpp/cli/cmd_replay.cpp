@@ -92,9 +92,13 @@ int run_replay(const ReplayArgs& a) {
   while (reader.next(s)) {
     rec.observe_reference(s);
     nav.feed(s);
+    for (const Estimate& e : nav.take_step_estimates()) rec.observe_estimate(e);  // a row per step
     rec.observe_estimate(nav.estimate());
     progress.update(reader.progress());
   }
+  nav.finish();  // a walk shorter than the bout gate is still reported
+  for (const Estimate& e : nav.take_step_estimates()) rec.observe_estimate(e);
+  rec.observe_estimate(nav.estimate());
   progress.done();
   rec.finish();
   rec.set_mode_changes(mode_change_notes(nav));
@@ -124,6 +128,9 @@ int run_replay(const ReplayArgs& a) {
   if (st.n > 0) summary["errors"] = st.to_json();
   summary["reference"] = rec.reference_kind();
   summary["fusion"] = fusion_summary(nav);
+  const fusion::NavigatorOutput o = nav.output(0);  // the PDR declination: model and any warning (#19.2)
+  summary["declination"] = {{"known", o.declination_known}, {"deg", rad_to_deg(o.declination.declination_rad)},
+                            {"model", o.declination.model}, {"warning", o.declination.warning}};
   std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
 
   std::cout << "log:      " << a.log << "\n"
