@@ -56,6 +56,7 @@ namespace {
 constexpr std::size_t kModeChangesKept = 1000;
 constexpr double kFusedRefreshS = 0.5;  // shown estimate refreshed at least this often (s of samples)
 constexpr std::size_t kModeChangesInOutput = 32;
+constexpr std::size_t kStepEstimatesKept = 256;  // per-step estimates held for take_step_estimates()
 
 std::string fmt(double v, int prec = 1) {
   std::ostringstream s;
@@ -267,6 +268,8 @@ struct Navigator::Impl {
       }
       Estimate e = choose();
       if (e.valid()) step_estimates.push_back(std::move(e));
+      // a caller that never takes them (the app) must not grow memory: the newest are kept
+      if (step_estimates.size() > kStepEstimatesKept) step_estimates.erase(step_estimates.begin());
     }
     for (const PdrTurn& t : pdr.take_turns())
       if (route) route->feed(t);

@@ -137,7 +137,8 @@ class Navigator {
   /// bout gate if it qualifies, and those steps reach the engines. Feed nothing afterwards.
   void finish();
   /// The estimate after each step since the last call, each at its step's own time (several
-  /// steps can be released by one sample); the replay writes one track row per step.
+  /// steps can be released by one sample); the replay writes one track row per step. The
+  /// newest 256 are held for a caller that never takes them.
   std::vector<Estimate> take_step_estimates();
   /// Declare or reset the start position (e.g. user long-press on the map).
   void set_start(double lat_deg, double lon_deg, double sigma_m, TimeNs t_ns);
