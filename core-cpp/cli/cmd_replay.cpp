@@ -117,9 +117,15 @@ int run_replay(const ReplayArgs& a) {
           }
         },
         s);
+    for (const Estimate& e : nav.take_step_estimates()) rec.observe_estimate(e);  // a row per step
     rec.observe_estimate(nav.estimate());
     progress.update(reader.progress());
   }
+  nav.finish();  // a walk shorter than the bout gate is still reported
+  twin.finish();
+  (void)twin.take_steps();
+  for (const Estimate& e : nav.take_step_estimates()) rec.observe_estimate(e);
+  rec.observe_estimate(nav.estimate());
   progress.done();
   rec.finish();
   rec.set_mode_changes(mode_change_notes(nav));
@@ -150,6 +156,9 @@ int run_replay(const ReplayArgs& a) {
   summary["reference"] = rec.reference_kind();
   summary["fusion"] = fusion_summary(nav);
   summary["pdr"] = pdr_summary_json(twin, nav.output(0).steps, std::max<TimeNs>(0, t0_ns));
+  const fusion::NavigatorOutput o = nav.output(0);  // the PDR declination: model and any warning (#19.2)
+  summary["declination"] = {{"known", o.declination_known}, {"deg", rad_to_deg(o.declination.declination_rad)},
+                            {"model", o.declination.model}, {"warning", o.declination.warning}};
   std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
 
   std::cout << "log:      " << a.log << "\n"

@@ -111,6 +111,9 @@ bool ReplayRecorder::reference_at(TimeNs t, geo::Geodetic* out) const {
 }
 
 void ReplayRecorder::finish() {
+  // step rows come at their steps' own times; a step released late (bout gate) may be earlier
+  // than the row before it
+  std::stable_sort(epochs_.begin(), epochs_.end(), [](const Epoch& a, const Epoch& b) { return a.est.t_ns < b.est.t_ns; });
   std::sort(truth_.begin(), truth_.end(), [](const Ref& a, const Ref& b) { return a.t_ns < b.t_ns; });
   std::sort(fixes_.begin(), fixes_.end(), [](const Ref& a, const Ref& b) { return a.t_ns < b.t_ns; });
   for (Epoch& ep : epochs_) {

@@ -6,6 +6,7 @@
 #include <map>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include <Eigen/LU>
 
@@ -55,6 +56,7 @@ namespace {
 constexpr std::size_t kModeChangesKept = 1000;
 constexpr double kFusedRefreshS = 0.5;  // shown estimate refreshed at least this often (s of samples)
 constexpr std::size_t kModeChangesInOutput = 32;
+constexpr std::size_t kStepEstimatesKept = 256;  // per-step estimates held for take_step_estimates()
 
 std::string fmt(double v, int prec = 1) {
   std::ostringstream s;
@@ -109,6 +111,7 @@ struct Navigator::Impl {
   std::int64_t steps = 0;
   std::int64_t first_utc_ms = kMissingInt;  // wall clock of the session (WMM date)
   geo::Geodetic start_position;
+  std::vector<Estimate> step_estimates;   // the estimate after each step, at its own time (take_step_estimates)
   double pending_start_lat = kNaN, pending_start_lon = kNaN, pending_start_sigma = kNaN;
 
   // --- the fused estimate (mode kAuto) ---
@@ -211,6 +214,15 @@ struct Navigator::Impl {
     started = true;
   }
 
+  /// The start position is known (configured or both Meta keys) but the Navigator has not
+  /// started yet: PDR gets the location now, so the first drained steps already carry the
+  /// declination (issue #20.2; they are drained before the start, which happens at a step).
+  void hint_location() {
+    if (started || !std::isfinite(pending_start_lat) || !std::isfinite(pending_start_lon)) return;
+    if (std::abs(pending_start_lat) > 90.0 || std::abs(pending_start_lon) > 180.0) return;  // start() counts it
+    pdr.set_location(geo::Geodetic::from_deg(pending_start_lat, pending_start_lon, 0.0), first_utc_ms);
+  }
+
   void maybe_start(TimeNs t_ns) {
     if (!started && std::isfinite(pending_start_lat)) start(pending_start_lat, pending_start_lon, pending_start_sigma, t_ns);
   }
@@ -228,6 +240,7 @@ struct Navigator::Impl {
     else if (m.key == "StartSigmaMeters" && !std::isfinite(cfg.start_lat_deg)) num(&pending_start_sigma);
     if (!std::isfinite(pending_start_sigma)) pending_start_sigma = cfg.start_sigma_m;
     if (m.key == "UserHeightMeters" && !std::isfinite(cfg.user_height_m)) height_from_log(m.value);
+    hint_location();
   }
 
   /// The recorded user height sets the step length, unless configured or steps were taken.
@@ -247,16 +260,21 @@ struct Navigator::Impl {
   }
 
   void drain_pdr() {
+    if (!pdr.has_location()) hint_location();
     for (const PdrStep& s : pdr.take_steps()) {
       ++steps;
       maybe_start(s.t_ns);
       dr.feed(s);
       if (fused && started) {
         fused_step(s);
-        continue;
+      } else {
+        if (terrain) terrain->feed(s);
+        if (route) route->feed(s);
       }
-      if (terrain) terrain->feed(s);
-      if (route) route->feed(s);
+      Estimate e = choose();
+      if (e.valid()) step_estimates.push_back(std::move(e));
+      // a caller that never takes them (the app) must not grow memory: the newest are kept
+      if (step_estimates.size() > kStepEstimatesKept) step_estimates.erase(step_estimates.begin());
     }
     for (const PdrTurn& t : pdr.take_turns())
       if (route) route->feed(t);
@@ -319,7 +337,9 @@ struct Navigator::Impl {
             if (x.utc_ms != kMissingInt && x.utc_ms > 0) first_utc_ms = x.utc_ms;
         },
         s);
-    if (first_utc_ms != kMissingInt && started) pdr.set_location(start_position, first_utc_ms);
+    if (first_utc_ms == kMissingInt) return;
+    if (started) pdr.set_location(start_position, first_utc_ms);
+    else hint_location();
   }
 
   void feed(const Sample& s) {
@@ -657,6 +677,7 @@ struct Navigator::Impl {
     if (applied.valid)
       e.reason += "; PDR scale " + fmt(applied.scale, 3) + " heading bias " + fmt(rad_to_deg(applied.heading_bias_rad)) + " deg";
     if (offset_en_m.norm() > 0.0) e.reason += "; blending " + fmt(offset_en_m.norm()) + " m";
+    if (!dr.has_absolute_heading() && steps > 0) e.reason += "; relative heading only";
     shown = std::move(e);
   }
 
@@ -687,8 +708,8 @@ struct Navigator::Impl {
         return t;
       }
     }
-    Estimate d = dr.estimate();
-    if (d.valid()) d.reason = std::string(why) + "dead reckoning";
+    Estimate d = dr.estimate();  // its reason says "relative heading only" while it is (issue #19.1)
+    if (d.valid()) d.reason = std::string(why) + d.reason;
     return d;
   }
 };
@@ -699,6 +720,13 @@ Navigator::Navigator(Navigator&&) noexcept = default;
 Navigator& Navigator::operator=(Navigator&&) noexcept = default;
 
 void Navigator::feed(const Sample& s) { impl_->feed(s); }
+
+void Navigator::finish() {
+  impl_->pdr.finish();
+  impl_->drain_pdr();
+}
+
+std::vector<Estimate> Navigator::take_step_estimates() { return std::exchange(impl_->step_estimates, {}); }
 
 void Navigator::set_start(double lat_deg, double lon_deg, double sigma_m, TimeNs t_ns) {
   impl_->start(lat_deg, lon_deg, sigma_m, t_ns);
@@ -722,6 +750,8 @@ NavigatorOutput Navigator::output(std::size_t max_particles) const {
   const std::size_t n = std::min(kModeChangesInOutput, impl_->changes.size());
   o.mode_changes.assign(impl_->changes.end() - static_cast<std::ptrdiff_t>(n), impl_->changes.end());
   o.calibration = impl_->applied;
+  o.declination_known = impl_->pdr.has_location();
+  o.declination = impl_->pdr.declination();
   return o;
 }
 

@@ -15,6 +15,7 @@
 #include "pdnav/geo/estimate.h"
 #include "pdnav/geo/samples.h"
 #include "pdnav/pdr/heading.h"
+#include "pdnav/geo/wmm.h"
 
 namespace pdnav::terrain { class Dem; }
 namespace pdnav::route { class WalkGraph; }
@@ -121,6 +122,11 @@ struct NavigatorOutput {
   std::vector<ModeChange> mode_changes;         // the most recent ones (up to 32), oldest first
   std::int64_t mode_change_count = 0;           // all since the start
   PdrCalibration calibration;                   // the PDR calibration in use (valid once published)
+  /// The magnetic declination applied to the PDR headings: its WMM model and any warning
+  /// (date outside every model's span, no UTC time). declination_known is false while the
+  /// headings are still magnetic (no location yet).
+  bool declination_known = false;
+  geo::Declination declination;
 };
 
 class Navigator {
@@ -133,6 +139,13 @@ class Navigator {
   /// Feed one sample. Samples should arrive in time order per sensor; out-of-order ones
   /// are counted and ignored. Never throws on bad sample values (they are counted).
   void feed(const Sample& s);
+  /// End of the input (end of a log, end of a session): PDR releases a walk shorter than its
+  /// bout gate if it qualifies, and those steps reach the engines. Feed nothing afterwards.
+  void finish();
+  /// The estimate after each step since the last call, each at its step's own time (several
+  /// steps can be released by one sample); the replay writes one track row per step. The
+  /// newest 256 are held for a caller that never takes them.
+  std::vector<Estimate> take_step_estimates();
   /// Declare or reset the start position (e.g. user long-press on the map).
   void set_start(double lat_deg, double lon_deg, double sigma_m, TimeNs t_ns);
 
