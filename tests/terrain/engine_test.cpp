@@ -208,8 +208,10 @@ TEST(TerrainEngine, SegmentMeanElevationRemovesTheSlopeLag) {
 }
 
 TEST(TerrainEngine, ResidualMonitorFlagsAnInconsistentBarometer) {
-  // After 150 consistent steps the barometer drifts by 0.5 Pa per step (~4 cm; 40 m over the
-  // next 1000 steps) that the terrain cannot explain: the innovation statistics must flag it,
+  // After 150 consistent steps the barometer drifts by 2 Pa per step (~17 cm, 0.3 m/s: 1.4 m per
+  // 10 m update, 30 m per DEM-error correlation length, far beyond weather or the srtm_tuned
+  // correlated DEM-error term the bias may follow; the earlier 0.5 Pa/step is within that
+  // term since issue 17) that the terrain cannot explain: the innovation statistics must flag it,
   // re-spread and report "recovering"; with the monitor off nothing is flagged.
   for (bool enabled : {true, false}) {
     TerrainOptions o = TerrainOptions::srtm_tuned();
@@ -218,7 +220,7 @@ TEST(TerrainEngine, ResidualMonitorFlagsAnInconsistentBarometer) {
     for (int k = 0; k < 150; ++k) walk.step(0.3);
     bool saw_recovering = false;
     for (int k = 0; k < 1000 && !saw_recovering; ++k) {
-      walk.step(0.3, -0.5 * k);
+      walk.step(0.3, -2.0 * k);
       saw_recovering = walk.pf.estimate().reason.find("recovering") != std::string::npos;
     }
     expect_finite(walk.pf.estimate());
