@@ -122,7 +122,9 @@ struct TerrainOptions {
   /// Beyond the paper, for 30-90 m DEMs (SRTM), tuned on simulated walks over six areas of an
   /// SRTM tile (docs/terrain.md): sigma_b 5 m, tau_b 600 s, R 20 m^2, an update every 10 m
   /// walked, a step-scale state (sigma 3 %), roughening K = 0.2, the segment-mean elevation and
-  /// the Rao-Blackwellised baro bias. The eval-terrain default.
+  /// the Rao-Blackwellised baro bias; since issue 17 also the correlated DEM-error term (5 m,
+  /// 150 m), the baro scale term (1.7 %) and the grade-varying stride (10 %, 300 m), for the
+  /// simulator's world error models. The eval-terrain default.
   static TerrainOptions srtm_tuned();
   /// "paper", "srtm" or "srtm-tuned"; throws std::invalid_argument.
   static TerrainOptions preset(const std::string& name);
