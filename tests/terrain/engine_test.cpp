@@ -292,5 +292,23 @@ TEST(TerrainEngine, NotInitializedAndBadInputs) {
   EXPECT_GT(TerrainEngine::bytes_per_particle(), 16u);
 }
 
+TEST(TerrainEngine, GradeStrideTermWidensTheAlongTrackCloud) {
+  // Issue 17: the step-scale state follows a FOGM in distance (stride varies with grade). On a
+  // flat tile (terrain uninformative: no updates) the along-track spread after 210 m must be
+  // clearly wider with the term than without; the cross-track spread (heading) barely changes.
+  auto flat = std::make_shared<const Dem>(test::synthetic_dem(201, 201, 30.0, [](double, double) { return 1500.0; }));
+  double along_m[2] = {0.0, 0.0};
+  for (bool on : {true, false}) {
+    TerrainOptions o = TerrainOptions::srtm_tuned();
+    o.particles = 4000;
+    if (!on) o.stride_grade_sigma = 0.0;
+    StraightWalk walk(flat, o);
+    for (int k = 0; k < 300; ++k) walk.step(0.0);  // 210 m north
+    expect_finite(walk.pf.estimate());
+    along_m[on ? 0 : 1] = std::sqrt(walk.pf.estimate().cov_en_m2(1, 1));
+  }
+  EXPECT_GT(along_m[0], 1.3 * along_m[1]) << "with " << along_m[0] << " m, without " << along_m[1] << " m";
+}
+
 }  // namespace
 }  // namespace pdnav::terrain
