@@ -111,6 +111,11 @@ TerrainOptions TerrainOptions::srtm_tuned() {
   o.roughening_k = 0.2;
   o.segment_mean_elevation = true;
   o.rao_blackwell_baro_bias = true;
+  o.dem_error_sigma_m = 5.0;
+  o.dem_error_corr_m = 150.0;
+  o.baro_scale_sigma = 0.017;
+  o.stride_grade_sigma = 0.10;
+  o.stride_grade_corr_m = 300.0;
   return o;
 }
 
@@ -140,6 +145,7 @@ struct TerrainEngine::Impl {
   int baro_count = 0;
   double walked_since_update_m = 0.0;
   double bias_var_m2 = 0.0;     // Rao-Blackwellised baro bias: common Kalman variance P
+  double last_z_m = kNaN;       // barometer altitude at the last update (scale-error term)
 
   std::vector<double> nis_window;
   std::size_t nis_next = 0;
@@ -238,6 +244,7 @@ struct TerrainEngine::Impl {
     stats.baro_jump_offset_m = 0.0;
     stats.baro_stuck = false;
     bias_var_m2 = opt.baro_bias_sigma_m * opt.baro_bias_sigma_m;
+    last_z_m = kNaN;
     nis_filled = nis_next = 0;
     recovering_until_ns = std::numeric_limits<TimeNs>::min();
     alarm.clear();
@@ -408,9 +415,33 @@ struct TerrainEngine::Impl {
     if (rb) {  // Kalman time update of the common variance; the means only fade
       bias_var_m2 = static_cast<double>(phi_b) * phi_b * bias_var_m2 + static_cast<double>(q_b) * q_b;
       q_b = 0.0f;
+      // Correlated DEM error (docs/terrain.md "issue 17, world errors"): the DEM error under a
+      // walker changes with distance walked, not time (correlation length L): the bias, which
+      // holds it, gains sigma^2 (1 - exp(-2 l / L)) per step of length l (a FOGM in distance).
+      if (opt.dem_error_sigma_m > 0.0 && opt.dem_error_corr_m > 0.0)
+        bias_var_m2 += opt.dem_error_sigma_m * opt.dem_error_sigma_m *
+                       (1.0 - std::exp(-2.0 * std::max(0.0, step.length_m) / opt.dem_error_corr_m));
+      // Barometric scale error (the day's temperature vs the ISA the altimeter assumes) makes the
+      // altitude error grow with the height climbed or descended since the last update.
+      if (std::isfinite(z) && opt.baro_scale_sigma > 0.0) {
+        if (std::isfinite(last_z_m)) {
+          const double dz = opt.baro_scale_sigma * (z - last_z_m);
+          bias_var_m2 += dz * dz;
+        }
+        last_z_m = z;
+      }
     }
     q_h *= static_cast<float>(gain);
     const auto len = static_cast<float>(step.length_m);
+    // Stride varies with grade along the route (shorter uphill and down; Minetti 1995 gait data):
+    // the scale state is a FOGM in distance (sigma, correlation length) on top of its per-walk
+    // draw. It reuses the bias noise draw, which is free when the bias is Rao-Blackwellised.
+    float phi_s = 1.0f, q_s = 0.0f;
+    if (rb && opt.stride_grade_sigma > 0.0 && opt.stride_grade_corr_m > 0.0) {
+      const double ph = std::exp(-std::max(0.0, step.length_m) / opt.stride_grade_corr_m);
+      phi_s = static_cast<float>(ph);
+      q_s = static_cast<float>(opt.stride_grade_sigma * std::sqrt(std::max(0.0, 1.0 - ph * ph)));
+    }
     const auto dl_span = static_cast<float>(2.0 * opt.step_length_sigma_m * gain);
     const auto s_th = static_cast<float>(std::sin(step.heading_rad));
     const auto c_th = static_cast<float>(std::cos(step.heading_rad));
@@ -425,7 +456,7 @@ struct TerrainEngine::Impl {
     float* pn = p.n.data();
     float* pbh = p.bh.data();
     float* pbb = p.bb.data();
-    const float* psc = p.sc.data();
+    float* psc = p.sc.data();
     float* ph0 = p.h0.data();
     const float* pan = p.an.data();
     const bool segment = opt.segment_mean_elevation && !h0_stale;
@@ -446,6 +477,7 @@ struct TerrainEngine::Impl {
       const float nb = (static_cast<float>((r2 & 0xFFFFu) + ((r2 >> 16) & 0xFFFFu) + ((r2 >> 32) & 0xFFFFu)) *
                             (1.0f / 65536.0f) - 1.5f) * 2.0f;
       pbb[i] = phi_b * pbb[i] + q_b * nb;
+      psc[i] = phi_s * psc[i] + q_s * nb;  // slope-varying stride (q_s = 0 unless the bias is RB)
       if (measure) {
         const float h = d.elevation_or_nan(pe[i], pn[i]);  // NaN = void / off the tile
         float pred = h;

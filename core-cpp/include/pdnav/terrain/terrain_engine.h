@@ -53,6 +53,22 @@ struct TerrainOptions {
   /// scalar Kalman filter (the variance is common to all particles) and is weighted by the
   /// marginal likelihood N(z; h + b, P + R) instead of sampling the bias. false = paper.
   bool rao_blackwell_baro_bias = false;
+  /// Beyond the paper (issue 17): SRTM's error is spatially correlated (Rodriguez et al. 2006:
+  /// ~6 m 90 % absolute height error, correlated over hundreds of metres; larger on slopes and
+  /// under canopy). With the Rao-Blackwellised bias, that error is a state the bias holds: its
+  /// variance grows by dem_error_sigma_m^2 (1 - exp(-2 l / dem_error_corr_m)) per step of l m
+  /// instead of being counted as white, independent evidence at every update. 0 = off.
+  double dem_error_sigma_m = 0.0;
+  double dem_error_corr_m = 150.0;
+  /// Beyond the paper (issue 17): relative barometric height-scale error from the day's
+  /// temperature vs ISA (5 K / 288 K ~ 1.7 %); adds (sigma x climb since the last update)^2 to
+  /// the bias variance. 0 = off. Both need rao_blackwell_baro_bias.
+  double baro_scale_sigma = 0.0;
+  /// Beyond the paper (issue 17): step length varies with grade (shorter on climbs and steep
+  /// descents), correlated over a climb: the step-scale state also follows a FOGM in distance
+  /// with this sigma and correlation length. Needs step_scale_sigma > 0 and the RB bias. 0 = off.
+  double stride_grade_sigma = 0.0;
+  double stride_grade_corr_m = 300.0;
   /// Beyond the paper: roughening after resampling (Gordon et al. 1993), K; 0 = off.
   double roughening_k = 0.0;
   // --- residual monitoring (the paper mentions it without detail; docs/terrain.md) ---
@@ -106,7 +122,9 @@ struct TerrainOptions {
   /// Beyond the paper, for 30-90 m DEMs (SRTM), tuned on simulated walks over six areas of an
   /// SRTM tile (docs/terrain.md): sigma_b 5 m, tau_b 600 s, R 20 m^2, an update every 10 m
   /// walked, a step-scale state (sigma 3 %), roughening K = 0.2, the segment-mean elevation and
-  /// the Rao-Blackwellised baro bias. The eval-terrain default.
+  /// the Rao-Blackwellised baro bias; since issue 17 also the correlated DEM-error term (5 m,
+  /// 150 m), the baro scale term (1.7 %) and the grade-varying stride (10 %, 300 m), for the
+  /// simulator's world error models. The eval-terrain default.
   static TerrainOptions srtm_tuned();
   /// "paper", "srtm" or "srtm-tuned"; throws std::invalid_argument.
   static TerrainOptions preset(const std::string& name);
