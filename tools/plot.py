@@ -8,6 +8,9 @@
                  is given: paths, streets, water, contours at the highest zoom that covers it)
       error.png  horizontal error vs time with the predicted 1-sigma and 2-sigma radius
                  (the layout of Broyles et al. 2018, Figs. 8-10)
+  tools/plot.py fusion OUT_DIR [--title T] [--out DIR]
+      fusion.png  a fused replay: the track coloured by the engine shown, and the horizontal
+                  error and predicted 1-sigma vs time with every span without GNSS shaded
   tools/plot.py gnss CSV [--out DIR]
       gnss_track.png, gnss_error.png, gnss_sats.png from `pdnav gnss --out CSV`
 
@@ -243,6 +246,53 @@ def plot_replay(args):
         print(f"plot: wrote {w}")
 
 
+ENGINE_COLOURS = {"gnss": "tab:blue", "route": "tab:green", "terrain": "tab:brown",
+                  "dead-reckoning": "tab:red"}
+
+
+def plot_fusion(args):
+    """Track by engine and error/sigma vs time with the spans where GNSS was not shown shaded."""
+    rows = read_csv(os.path.join(args.dir, "track.csv"))
+    t = (col(rows, "t_ns") - float(rows[0]["t_ns"])) * 1e-9
+    e, n = col(rows, "e_m"), col(rows, "n_m")
+    err = np.hypot(col(rows, "err_e_m"), col(rows, "err_n_m"))
+    sig = col(rows, "semi_major_m")
+    eng = [r["engine"] for r in rows]
+    if not np.isfinite(err).any():
+        sys.exit(f"plot: {args.dir}/track.csv has no reference (Truth lines or phone fixes): nothing to score")
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(9, 10), gridspec_kw={"height_ratios": [3, 2]})
+    for name in sorted(set(eng)):
+        m = np.array([x == name for x in eng])
+        ax1.plot(e[m], n[m], ".", ms=2, color=ENGINE_COLOURS.get(name, "tab:gray"), label=f"shown: {name}")
+    ref_e, ref_n = e - col(rows, "err_e_m"), n - col(rows, "err_n_m")
+    ax1.plot(ref_e, ref_n, "k-", lw=0.8, label="truth")
+    ax1.set_aspect("equal")
+    ax1.set_xlabel("east (m)")
+    ax1.set_ylabel("north (m)")
+    ax1.legend(loc="best", fontsize=8)
+    ax1.set_title(args.title or "fused replay: the shown estimate by engine")
+    no_gnss = np.array([x != "gnss" for x in eng])
+    start = None
+    for i, flag in enumerate(list(no_gnss) + [False]):
+        if flag and start is None:
+            start = i
+        elif not flag and start is not None:
+            ax2.axvspan(t[start], t[i - 1], color="0.85", lw=0)
+            start = None
+    ax2.plot(t, err, "b-", lw=0.8, label="horizontal error")
+    ax2.plot(t, sig, "r--", lw=0.8, label="predicted 1-sigma (semi-major)")
+    ax2.set_xlabel("time (s); grey = GNSS not shown")
+    ax2.set_ylabel("m")
+    ax2.legend(loc="upper left", fontsize=8)
+    fig.tight_layout()
+    out = args.out or args.dir
+    os.makedirs(out, exist_ok=True)
+    p = os.path.join(out, "fusion.png")
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    print(f"plot: wrote {p}")
+
+
 def plot_gnss(args):
     rows = read_csv(args.csv)
     out = args.out or os.path.dirname(os.path.abspath(args.csv))
@@ -310,11 +360,15 @@ def main():
                    "basemap (dem-tools/pdnav_basemap.py)")
     r.add_argument("--out", help="folder for the PNGs (default: the replay folder)")
     r.add_argument("--title")
+    fu = sub.add_parser("fusion", help="track by engine and error vs time of a fused `pdnav replay`")
+    fu.add_argument("dir")
+    fu.add_argument("--out")
+    fu.add_argument("--title")
     g = sub.add_parser("gnss", help="plots of a `pdnav gnss --out CSV` file")
     g.add_argument("csv")
     g.add_argument("--out")
     args = ap.parse_args()
-    plot_replay(args) if args.cmd == "replay" else plot_gnss(args)
+    {"replay": plot_replay, "fusion": plot_fusion, "gnss": plot_gnss}[args.cmd](args)
 
 
 if __name__ == "__main__":
