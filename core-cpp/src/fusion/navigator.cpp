@@ -459,7 +459,10 @@ struct Navigator::Impl {
     const TimeNs t = sol.t_ns;
     // The GNSS engine's KF accepted this epoch's fix: its position (SPP smoothed by the carrier)
     // is the measurement, and the displacement it already contains is not used again.
-    const bool use_kf = fo().use_gnss_kf && sol.spp_ok && sol.kf_ok && sol.kf_update_accepted &&
+    // (Re-)acquisition stays on the raw fix's wider sigma: the KF is used only while the fused
+    // filter is locked to GNSS (an accepted position within kf_locked_within_s).
+    const bool locked = ff.last_accepted_ns() >= 0 && t - ff.last_accepted_ns() <= ns(fo().kf_locked_within_s);
+    const bool use_kf = fo().use_gnss_kf && locked && sol.spp_ok && sol.kf_ok && sol.kf_update_accepted &&
                         sol.kf_cov_enu.allFinite() && sol.kf_cov_enu.topLeftCorner<2, 2>().determinant() > 0.0;
     if (!(use_kf && fo().kf_skip_displacement) && sol.disp_dt_s > 0.0 && !sol.disp_source.empty()) {
       const double sd = sol.disp_source == "tdcp" ? fo().tdcp_sigma_m : fo().doppler_sigma_mps * sol.disp_dt_s;

@@ -49,6 +49,7 @@ struct FusionOptions {
   double kf_min_sigma_m = 1.0;        // floor of the KF position 1-sigma per axis (phone code + carrier class)
   double kf_sigma_scale = 1.0;        // KF covariance scale (1 = taken as reported)
   double kf_floor_fraction = 1.0;     // fused P_pos >= this x R_kf after a KF update
+  double kf_locked_within_s = 3.0;    // KF used only after the fused filter accepted a position this recently
   bool kf_skip_displacement = false;  // drop TDCP/Doppler while the KF position is used (see docs/fusion.md)
   /// Chipset Fix rows: Android accuracy is a 68 % horizontal radius, sigma = accuracy / 1.51;
   /// scaled for their time correlation (the chipset's own filter). Used only when no Raw
