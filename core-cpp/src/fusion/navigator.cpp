@@ -458,7 +458,8 @@ struct Navigator::Impl {
   void fused_epoch(const gnss::EpochSolution& sol) {
     const TimeNs t = sol.t_ns;
     // The GNSS engine's KF accepted this epoch's fix: its position (SPP smoothed by the carrier)
-    // is the measurement, and the displacement it already contains is not used again.
+    // is the measurement instead of the raw fix, its time correlation bounded by a covariance
+    // floor of 1 x R_kf; TDCP stays in (it constrains the PDR states; docs/fusion.md).
     // (Re-)acquisition stays on the raw fix's wider sigma: the KF is used only while the fused
     // filter is locked to GNSS (an accepted position within kf_locked_within_s).
     const bool locked = ff.last_accepted_ns() >= 0 && t - ff.last_accepted_ns() <= ns(fo().kf_locked_within_s);

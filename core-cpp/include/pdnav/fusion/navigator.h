@@ -39,12 +39,12 @@ struct FusionOptions {
   double degraded_sigma_scale = 1.5;
   double tdcp_sigma_m = 0.10;         // per axis, TDCP displacement (cm-level + phase-centre motion)
   double doppler_sigma_mps = 0.30;    // per axis, Doppler-derived velocity
-  /// While the GNSS engine's own KF (SPP smoothed by TDCP/Doppler) accepted this epoch's fix,
-  /// its position and covariance are the measurement instead of the raw SPP fix and the TDCP
-  /// displacement (which that KF already contains: using both would count the carrier twice).
-  /// Cascaded-filter rule (Carlson 1990, "Federated square root filter", Sec. II): the KF output
-  /// is time-correlated, so after the update the fused position covariance is kept >= the KF's
-  /// (floor fraction 1), never averaging successive KF outputs as if independent. docs/fusion.md.
+  /// While the fused filter is locked to GNSS and the GNSS engine's own KF (SPP smoothed by
+  /// TDCP/Doppler) accepted this epoch's fix, its position and covariance are the measurement
+  /// instead of the raw SPP fix. Cascaded-filter rule (Carlson 1990, "Federated square root
+  /// filter", Sec. II): the KF output is time-correlated and already holds the carrier, so after
+  /// the update the fused position covariance is kept >= the KF's (floor fraction 1), never
+  /// averaging successive KF outputs as if independent. docs/fusion.md (issue 14).
   bool use_gnss_kf = true;
   double kf_min_sigma_m = 1.0;        // floor of the KF position 1-sigma per axis (phone code + carrier class)
   double kf_sigma_scale = 1.0;        // KF covariance scale (1 = taken as reported)
