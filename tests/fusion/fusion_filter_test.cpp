@@ -117,6 +117,29 @@ TEST(FusionFilter, TdcpDisplacementCorrectsTheStepLength) {
   EXPECT_NEAR(f.scale_error(), 0.8 / 0.7 - 1.0, 0.02);
 }
 
+// Issue 14: an already-filtered GNSS position (the engine's KF) is time-correlated, so a run of
+// them never makes the fused position more certain than one of them: with floor_fraction 1
+// the position covariance stays >= R; the default (0.25) lets it fall to R / 4.
+TEST(FusionFilter, FloorFractionOverrideKeepsPositionCovarianceAtTheFilteredMeasurements) {
+  const Eigen::Matrix2d r = 1.5 * 1.5 * Eigen::Matrix2d::Identity();
+  auto run = [&](double floor_fraction) {
+    FusionFilter f;
+    f.initialize(Eigen::Vector2d::Zero(), 3.0, 0);
+    for (int k = 1; k <= 120; ++k) {
+      const PositionUpdateResult res =
+          f.update_position(k * kNsPerS, Eigen::Vector2d(0.5, -0.5), r, true, floor_fraction);
+      if (k > 2) EXPECT_TRUE(res.accepted) << k;
+    }
+    const Eigen::Matrix2d p = f.position_cov_m2();
+    return 0.5 * p.trace() - std::sqrt(0.25 * p.trace() * p.trace() - p.determinant());  // smallest eigenvalue
+  };
+  const double lmin_kf = run(1.0), lmin_default = run(-1.0);
+  EXPECT_GE(lmin_kf, 0.999 * r(0, 0));
+  EXPECT_LT(lmin_kf, 1.2 * r(0, 0));  // not inflated beyond the floor
+  EXPECT_LT(lmin_default, 0.5 * r(0, 0));
+  EXPECT_GE(lmin_default, 0.999 * 0.25 * r(0, 0));
+}
+
 TEST(FusionFilter, Chi2QuantileMatchesTables) {
   EXPECT_NEAR(chi2_quantile(2, 0.99), 9.21, 0.15);
   EXPECT_NEAR(chi2_quantile(8, 0.99), 20.09, 0.2);

@@ -141,7 +141,7 @@ void FusionFilter::apply_position(const Eigen::Vector2d& z, const Eigen::Matrix2
   const double lmin = 0.5 * tr - std::sqrt(std::max(0.0, 0.25 * tr * tr - det));
   const double rtr = r.trace(), rdet = r.determinant();
   const double rmin = 0.5 * rtr - std::sqrt(std::max(0.0, 0.25 * rtr * rtr - rdet));
-  const double floor = opt_.position_floor_fraction * rmin;
+  const double floor = (floor_fraction_ >= 0.0 ? floor_fraction_ : opt_.position_floor_fraction) * rmin;
   if (lmin < floor) {
     p_(0, 0) += floor - lmin;
     p_(1, 1) += floor - lmin;
@@ -164,8 +164,9 @@ bool FusionFilter::agree(const std::vector<Held>& h, Eigen::Vector2d* mean_nu) c
 }
 
 PositionUpdateResult FusionFilter::update_position(TimeNs t_ns, const Eigen::Vector2d& z_en_m, const Eigen::Matrix2d& r_in,
-                                                   bool use_gate_policy) {
+                                                   bool use_gate_policy, double floor_fraction) {
   PositionUpdateResult res;
+  floor_fraction_ = floor_fraction;
   if (!initialized_ || !z_en_m.allFinite() || !r_in.allFinite() || !(r_in.determinant() > 0.0)) {
     res.reason = "invalid measurement";
     return res;

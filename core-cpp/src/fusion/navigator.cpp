@@ -482,7 +482,15 @@ struct Navigator::Impl {
 
   void fused_epoch(const gnss::EpochSolution& sol) {
     const TimeNs t = sol.t_ns;
-    if (sol.disp_dt_s > 0.0 && !sol.disp_source.empty()) {
+    // The GNSS engine's KF accepted this epoch's fix: its position (SPP smoothed by the carrier)
+    // is the measurement instead of the raw fix, its time correlation bounded by a covariance
+    // floor of 1 x R_kf; TDCP stays in (it constrains the PDR states; docs/fusion.md).
+    // (Re-)acquisition stays on the raw fix's wider sigma: the KF is used only while the fused
+    // filter is locked to GNSS (an accepted position within kf_locked_within_s).
+    const bool locked = ff.last_accepted_ns() >= 0 && t - ff.last_accepted_ns() <= ns(fo().kf_locked_within_s);
+    const bool use_kf = fo().use_gnss_kf && locked && sol.spp_ok && sol.kf_ok && sol.kf_update_accepted &&
+                        sol.kf_cov_enu.allFinite() && sol.kf_cov_enu.topLeftCorner<2, 2>().determinant() > 0.0;
+    if (!(use_kf && fo().kf_skip_displacement) && sol.disp_dt_s > 0.0 && !sol.disp_source.empty()) {
       const double sd = sol.disp_source == "tdcp" ? fo().tdcp_sigma_m : fo().doppler_sigma_mps * sol.disp_dt_s;
       const Eigen::Vector2d before = ff.position_en_m();
       double nis = 0.0;
@@ -500,14 +508,31 @@ struct Navigator::Impl {
       const bool degraded = sol.sats_used < fo().min_sats_ok;
       double sigma = std::max(fo().min_spp_sigma_m, fo().spp_uere_m * hdop);
       if (degraded) sigma *= fo().degraded_sigma_scale;
+      const double spp_sigma = sigma;
+      Eigen::Vector2d zm = z;
+      Eigen::Matrix2d rm = sigma * sigma * Eigen::Matrix2d::Identity();
+      double floor_fraction = -1.0;
+      if (use_kf) {
+        zm = frame.to_enu(sol.kf).p_m.head<2>();
+        rm = fo().kf_sigma_scale * sol.kf_cov_enu.topLeftCorner<2, 2>();
+        rm = 0.5 * (rm + rm.transpose()).eval();
+        const double v_min = fo().kf_min_sigma_m * fo().kf_min_sigma_m;
+        rm(0, 0) = std::max(rm(0, 0), v_min);
+        rm(1, 1) = std::max(rm(1, 1), v_min);
+        if (degraded) rm *= fo().degraded_sigma_scale * fo().degraded_sigma_scale;
+        sigma = std::sqrt(0.5 * rm.trace());
+        floor_fraction = fo().kf_floor_fraction;
+        ++counts["GNSS: engine KF position used"];
+      }
       const Eigen::Vector2d before = ff.position_en_m();
-      const PositionUpdateResult r = ff.update_position(t, z, sigma * sigma * Eigen::Matrix2d::Identity());
+      const PositionUpdateResult r = ff.update_position(t, zm, rm, true, floor_fraction);
       note_result(r, "GNSS");
       if (r.accepted) {
         if (std::isfinite(g.h_m)) height_m = g.h_m;
-        accepted_gnss(t, z, sigma, degraded,
-                      "SPP " + std::to_string(sol.sats_used) + " sats, sigma " + fmt(sigma) + " m" +
-                          (sol.disp_source.empty() ? "" : " + " + sol.disp_source));
+        // the PDR calibrator keeps the raw fixes (its window model assumes independent epochs)
+        accepted_gnss(t, z, spp_sigma, degraded,
+                      std::string(use_kf ? "GNSS KF" : "SPP") + " " + std::to_string(sol.sats_used) + " sats, sigma " +
+                          fmt(sigma) + " m" + (sol.disp_source.empty() ? "" : " + " + sol.disp_source));
         if (r.reacquired) refresh_mode(t, "GNSS " + r.reason);
       }
       after_update(before);

@@ -72,8 +72,10 @@ class FusionFilter {
   void set_residual_uncertainty(double heading_bias_var_rad2, double scale_var);
   /// Position measurement at t_ns (possibly before the last step: the steps after it are
   /// taken off the prediction) through the windowed gate. `R` is its 2x2 covariance.
+  /// `floor_fraction` >= 0 replaces options().position_floor_fraction for this update (and the
+  /// held epochs it may apply), e.g. 1 for an already-filtered, time-correlated measurement.
   PositionUpdateResult update_position(TimeNs t_ns, const Eigen::Vector2d& z_en_m, const Eigen::Matrix2d& r_m2,
-                                       bool use_gate_policy = true);
+                                       bool use_gate_policy = true, double floor_fraction = -1.0);
   /// Displacement since the clone (the last GNSS epoch), e.g. TDCP. Returns accepted.
   bool update_displacement(TimeNs t_ns, TimeNs from_ns, const Eigen::Vector2d& d_en_m, const Eigen::Matrix2d& r_m2,
                            double* nis = nullptr);
@@ -103,6 +105,7 @@ class FusionFilter {
   void symmetrize();
 
   FusionFilterOptions opt_;
+  double floor_fraction_ = -1.0;  // per-update override of opt_.position_floor_fraction (< 0: none)
   bool initialized_ = false;
   Vec6 x_ = Vec6::Zero();
   Mat6 p_ = Mat6::Identity();

@@ -41,6 +41,18 @@ struct FusionOptions {
   double degraded_sigma_scale = 1.5;
   double tdcp_sigma_m = 0.10;         // per axis, TDCP displacement (cm-level + phase-centre motion)
   double doppler_sigma_mps = 0.30;    // per axis, Doppler-derived velocity
+  /// While the fused filter is locked to GNSS and the GNSS engine's own KF (SPP smoothed by
+  /// TDCP/Doppler) accepted this epoch's fix, its position and covariance are the measurement
+  /// instead of the raw SPP fix. Cascaded-filter rule (Carlson 1990, "Federated square root
+  /// filter", Sec. II): the KF output is time-correlated and already holds the carrier, so after
+  /// the update the fused position covariance is kept >= the KF's (floor fraction 1), never
+  /// averaging successive KF outputs as if independent. docs/fusion.md (issue 14).
+  bool use_gnss_kf = true;
+  double kf_min_sigma_m = 1.0;        // floor of the KF position 1-sigma per axis (phone code + carrier class)
+  double kf_sigma_scale = 1.0;        // KF covariance scale (1 = taken as reported)
+  double kf_floor_fraction = 1.0;     // fused P_pos >= this x R_kf after a KF update
+  double kf_locked_within_s = 3.0;    // KF used only after the fused filter accepted a position this recently
+  bool kf_skip_displacement = false;  // drop TDCP/Doppler while the KF position is used (see docs/fusion.md)
   /// Chipset Fix rows: Android accuracy is a 68 % horizontal radius, sigma = accuracy / 1.51;
   /// scaled for their time correlation (the chipset's own filter). Used only when no Raw
   /// epoch has given a position for fix_fallback_after_s.

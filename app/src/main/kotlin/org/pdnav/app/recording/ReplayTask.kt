@@ -10,7 +10,7 @@ import org.pdnav.app.nav.SessionFeeder
 /**
  * Replays a recorded session through a fresh navigator on a background thread (owned by
  * NavigationService, so it survives the Activity). Rows go to the native side in batches
- * of [CHUNK] (one JNI call each, not one per row) through a [SessionFeeder], which applies
+ * of [chunk] rows (default [CHUNK]; one JNI call each, not one per row) through a [SessionFeeder], which applies
  * the declared starts the session recorded and scores its `Truth` checkpoints ([checkpoints]).
  * [onProgress] gets the output and the fraction read about every [everyNs] of log time
  * (at batch ends); [onDone] the final output, or the error that stopped it.
@@ -22,6 +22,7 @@ class ReplayTask(
     private val onProgress: (NavOutput, Double) -> Unit,
     private val onDone: (NavOutput?, Exception?) -> Unit,
     private val everyNs: Long = 1_000_000_000L,
+    private val chunk: Int = CHUNK,
 ) {
     @Volatile private var cancelled = false
     private var thread: Thread? = null
@@ -54,9 +55,9 @@ class ReplayTask(
             NativeNavigator(config, seed).use { nav ->
                 val feeder = SessionFeeder(nav)
                 NativeLogReader(path).use { reader ->
-                    val batch = SampleBatch(CHUNK)
+                    val batch = SampleBatch(chunk)
                     var nextReportNs = Long.MIN_VALUE
-                    while (!cancelled && reader.read(batch, CHUNK)) {
+                    while (!cancelled && reader.read(batch, chunk)) {
                         feeder.write(batch)
                         feedCalls = feeder.feedCalls
                         val t = batch.tNs(batch.size - 1)

@@ -87,7 +87,9 @@ class SettingsActivity : Activity() {
             isEnabled = android.os.Build.VERSION.SDK_INT >= 31
         }
         addView(fullTracking)
-        addView(TextView(context).apply { text = getString(R.string.settings_start_note) })
+        // a multi-line note: as wide as the form, so its lines wrap to the box it is drawn in
+        addView(TextView(context).apply { text = getString(R.string.settings_start_note) },
+            LinearLayout.LayoutParams(LinearLayout.LayoutParams.MATCH_PARENT, LinearLayout.LayoutParams.WRAP_CONTENT))
         progress = ProgressBar(context, null, android.R.attr.progressBarStyleHorizontal).apply {
             id = R.id.settings_progress
             max = 1000
