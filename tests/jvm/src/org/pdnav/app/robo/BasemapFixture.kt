@@ -135,7 +135,7 @@ object BasemapFixture {
                 val innerH = v.height - v.compoundPaddingTop - v.compoundPaddingBottom
                 assertTrue(layout.height <= innerH + 1, "$name: text ${layout.height} px high in a ${innerH} px box")
                 for (i in 0 until layout.lineCount) {
-                    val w = layout.getLineWidth(i)
+                    val w = layout.getLineMax(i)  // the drawn extent; getLineWidth adds trailing whitespace
                     val innerW = v.width - v.compoundPaddingLeft - v.compoundPaddingRight
                     assertTrue(w <= innerW + 1, "$name: line $i is $w px wide in a $innerW px box")
                 }
