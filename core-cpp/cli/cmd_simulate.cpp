@@ -9,21 +9,19 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
-#include <Eigen/Geometry>
 
-#include "pdnav/geo/wmm.h"
 #include "pdnav/gnss/ephemeris.h"
 #include "pdnav/io/log_writer.h"
 #include "pdnav/phonesim/phone_session.h"
 #include "pdnav/route/walk_graph.h"
 #include "pdnav/terrain/dem.h"
 #include "pdnav/terrain/simulator.h"
+#include "support/walk_log.h"
 
 namespace pdnav::cli {
 namespace {
@@ -47,77 +45,12 @@ struct SimulateArgs {
   bool declare_start = false;
 };
 
-std::string num(double v, int digits = 9) {
-  std::ostringstream os;
-  os << std::setprecision(digits) << v;
-  return os.str();
-}
-
 MetaSample meta(const std::string& key, const std::string& value) {
   MetaSample m;
   m.t_ns = 0;
   m.key = key;
   m.value = value;
   return m;
-}
-
-/// Wall-clock time of a simulated session's first sample (2026-06-01T08:00Z): sets the
-/// utc_ms of every sample, so the replay's WMM declination is that of a real session.
-constexpr std::int64_t kSimSessionStartUnixMs = 1780300800000;
-
-/// Rotation vector (phone -> ENU, magnetic north) of a chest-mounted phone, top edge up,
-/// camera facing the walking direction (pdr::Mount::kChestCameraOut, the app's mount):
-/// phone -Z = forward = (sin h, cos h, 0), phone +Y = up, phone +X = forward x up.
-RotationVectorSample rotation_for_heading(TimeNs t_ns, std::int64_t utc_ms, double magnetic_heading_rad,
-                                          double accuracy_rad) {
-  const double sh = std::sin(magnetic_heading_rad), ch = std::cos(magnetic_heading_rad);
-  Eigen::Matrix3d r;  // columns: phone X, Y, Z in ENU
-  r.col(0) = Eigen::Vector3d(ch, -sh, 0.0);
-  r.col(1) = Eigen::Vector3d(0.0, 0.0, 1.0);
-  r.col(2) = Eigen::Vector3d(-sh, -ch, 0.0);
-  const Eigen::Quaterniond q(r);
-  RotationVectorSample out;
-  out.t_ns = t_ns;
-  out.utc_ms = utc_ms;
-  out.quat_xyzw = Eigen::Vector4d(q.x(), q.y(), q.z(), q.w());
-  out.heading_accuracy_rad = accuracy_rad;
-  return out;
-}
-
-/// Merge the walk's streams into one time-ordered sample list (Meta lines first).
-std::vector<Sample> to_samples(const terrain::SimulatedWalk& w, const SimulateArgs& a, const terrain::Dem& dem) {
-  std::vector<Sample> out;
-  out.emplace_back(meta("StartLatitudeDegrees", num(w.declared_start.lat_deg(), 12)));
-  out.emplace_back(meta("StartLongitudeDegrees", num(w.declared_start.lon_deg(), 12)));
-  out.emplace_back(meta("StartSigmaMeters", num(w.declared_sigma_m)));
-  out.emplace_back(meta("UserHeightMeters", num(a.user_height_m)));
-  out.emplace_back(meta("DemFile", a.dem));
-  out.emplace_back(meta("DemSourceSha256", dem.info().source_sha256));
-  out.emplace_back(meta("HeadingReference", "magnetic (rotation vector, chest mount, camera forward)"));
-  out.emplace_back(meta("Simulator", "pdnav simulate seed " + std::to_string(a.seed)));
-  const auto utc_of = [&](TimeNs t_ns) { return kSimSessionStartUnixMs + (t_ns - w.t0_ns) / kNsPerMs; };
-  // The phone reports magnetic heading: subtract the WMM declination the replay will add back.
-  const double declination_rad = geo::magnetic_declination_rad(w.declared_start, kSimSessionStartUnixMs);
-  auto pressure = [&](std::size_t i) {
-    PressureSample p = w.pressure[i];
-    p.utc_ms = utc_of(p.t_ns);
-    return p;
-  };
-  std::size_t ip = 0;
-  for (std::size_t k = 0; k < w.steps.size(); ++k) {
-    const PdrStep& s = w.steps[k];
-    while (ip < w.pressure.size() && w.pressure[ip].t_ns <= s.t_ns) out.emplace_back(pressure(ip++));
-    // The heading sensor reports just before the step event.
-    const TimeNs t_rv = s.t_ns - kNsPerMs;
-    out.emplace_back(rotation_for_heading(t_rv, utc_of(t_rv), s.heading_rad - declination_rad, s.heading_sigma_rad));
-    StepDetectorSample sd;
-    sd.t_ns = s.t_ns;
-    sd.utc_ms = utc_of(s.t_ns);
-    out.emplace_back(sd);
-    out.emplace_back(w.truth[k]);
-  }
-  while (ip < w.pressure.size()) out.emplace_back(pressure(ip++));
-  return out;
 }
 
 void write_truth_csv(const std::string& path, const terrain::SimulatedWalk& w) {
@@ -198,7 +131,7 @@ int run_simulate(const SimulateArgs& a) {
     io::LogWriterOptions wo;
     wo.device = "pdnav simulate";
     io::LogWriter writer(a.log, wo);
-    for (const Sample& s : to_samples(w, a, dem)) writer.write(s);
+    for (const Sample& s : walk_to_samples(w, dem, a.user_height_m, a.dem, a.seed, "pdnav simulate")) writer.write(s);
     writer.close();
   }
   const std::string truth = a.truth_csv.empty() ? a.log + ".truth.csv" : a.truth_csv;

@@ -44,7 +44,8 @@ RotationVectorSample chest_rotation_for_heading(TimeNs t_ns, std::int64_t utc_ms
 }
 
 std::vector<Sample> walk_to_samples(const terrain::SimulatedWalk& w, const terrain::Dem& dem, double user_height_m,
-                                    const std::string& dem_name, std::uint64_t seed) {
+                                    const std::string& dem_name, std::uint64_t seed,
+                                    const std::string& simulator) {
   std::vector<Sample> out;
   out.reserve(3 * w.steps.size() + w.pressure.size() + 8);
   out.emplace_back(meta("StartLatitudeDegrees", num(w.declared_start.lat_deg(), 12)));
@@ -54,7 +55,7 @@ std::vector<Sample> walk_to_samples(const terrain::SimulatedWalk& w, const terra
   out.emplace_back(meta("DemFile", dem_name));
   out.emplace_back(meta("DemSourceSha256", dem.info().source_sha256));
   out.emplace_back(meta("HeadingReference", "magnetic (rotation vector, chest mount, camera forward)"));
-  out.emplace_back(meta("Simulator", "pdnav eval-terrain walk seed " + std::to_string(seed)));
+  out.emplace_back(meta("Simulator", simulator + " seed " + std::to_string(seed)));
   const auto utc_of = [&](TimeNs t_ns) { return kSimSessionStartUnixMs + (t_ns - w.t0_ns) / kNsPerMs; };
   // The phone reports magnetic heading: subtract the WMM declination the replay adds back.
   const double declination_rad = geo::magnetic_declination_rad(w.declared_start, kSimSessionStartUnixMs);

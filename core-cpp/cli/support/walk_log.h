@@ -2,7 +2,7 @@
 // (declared start, user height, DEM), rotation vector (chest mount, magnetic heading) before
 // each Android step event, pressure, and Truth lines. Used by eval-terrain's app path, which
 // writes it through io::LogWriter, reads it back with io::LogReader and replays it through
-// fusion::Navigator exactly as `pdnav replay` does. Same conversion as `pdnav simulate`.
+// fusion::Navigator exactly as `pdnav replay` does, and by `pdnav simulate` to write the log.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -23,8 +23,10 @@ inline constexpr std::int64_t kSimSessionStartUnixMs = 1780300800000;
 RotationVectorSample chest_rotation_for_heading(TimeNs t_ns, std::int64_t utc_ms, double magnetic_heading_rad,
                                                 double accuracy_rad);
 
-/// Time-ordered samples of the walk (Meta lines first). dem_name goes into Meta DemFile.
+/// Time-ordered samples of the walk (Meta lines first). dem_name goes into Meta DemFile,
+/// "<simulator> seed <seed>" into Meta Simulator (which command made the walk).
 std::vector<Sample> walk_to_samples(const terrain::SimulatedWalk& w, const terrain::Dem& dem, double user_height_m,
-                                    const std::string& dem_name, std::uint64_t seed);
+                                    const std::string& dem_name, std::uint64_t seed,
+                                    const std::string& simulator = "pdnav eval-terrain walk");
 
 }  // namespace pdnav::cli
