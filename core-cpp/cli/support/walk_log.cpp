@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "pdnav/geo/wmm.h"
+#include "pdnav/sim/world.h"
 
 namespace pdnav::cli {
 namespace {
@@ -28,17 +29,10 @@ MetaSample meta(const std::string& key, const std::string& value) {
 
 RotationVectorSample chest_rotation_for_heading(TimeNs t_ns, std::int64_t utc_ms, double magnetic_heading_rad,
                                                 double accuracy_rad) {
-  // phone -Z = forward = (sin h, cos h, 0), phone +Y = up, phone +X = forward x up.
-  const double sh = std::sin(magnetic_heading_rad), ch = std::cos(magnetic_heading_rad);
-  Eigen::Matrix3d r;  // columns: phone X, Y, Z in ENU
-  r.col(0) = Eigen::Vector3d(ch, -sh, 0.0);
-  r.col(1) = Eigen::Vector3d(0.0, 0.0, 1.0);
-  r.col(2) = Eigen::Vector3d(-sh, -ch, 0.0);
-  const Eigen::Quaterniond q(r);
   RotationVectorSample out;
   out.t_ns = t_ns;
   out.utc_ms = utc_ms;
-  out.quat_xyzw = Eigen::Vector4d(q.x(), q.y(), q.z(), q.w());
+  out.quat_xyzw = sim::chest_mount_quat_xyzw(magnetic_heading_rad);
   out.heading_accuracy_rad = accuracy_rad;
   return out;
 }

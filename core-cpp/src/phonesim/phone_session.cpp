@@ -13,6 +13,7 @@
 #include "pdnav/geo/frames.h"
 #include "pdnav/geo/time.h"
 #include "pdnav/geo/wmm.h"
+#include "pdnav/sim/world.h"
 #include "pdnav/gnss/atmosphere.h"
 #include "pdnav/gnss/measurements.h"
 #include "pdnav/gnss/solver_synthetic.h"
@@ -128,16 +129,10 @@ double horizon_rad(const terrain::Dem& dem, double e, double n, double h, double
 }
 
 RotationVectorSample rotation_for_heading(TimeNs t_ns, std::int64_t utc_ms, double magnetic_heading_rad) {
-  const double sh = std::sin(magnetic_heading_rad), ch = std::cos(magnetic_heading_rad);
-  Eigen::Matrix3d r;  // chest mount, camera forward: phone -Z = forward, +Y = up
-  r.col(0) = Eigen::Vector3d(ch, -sh, 0.0);
-  r.col(1) = Eigen::Vector3d(0.0, 0.0, 1.0);
-  r.col(2) = Eigen::Vector3d(-sh, -ch, 0.0);
-  const Eigen::Quaterniond q(r);
   RotationVectorSample out;
   out.t_ns = t_ns;
   out.utc_ms = utc_ms;
-  out.quat_xyzw = Eigen::Vector4d(q.x(), q.y(), q.z(), q.w());
+  out.quat_xyzw = sim::chest_mount_quat_xyzw(magnetic_heading_rad);
   out.heading_accuracy_rad = 10.0 * kDegToRad;
   return out;
 }

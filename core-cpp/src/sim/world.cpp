@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <Eigen/Geometry>
+
 #include "pdnav/geo/baro.h"
 
 namespace pdnav::sim {
@@ -24,6 +26,16 @@ std::vector<Interval> poisson_intervals(double rate_per_s, double min_s, double 
     t += dur;
   }
   return out;
+}
+
+Eigen::Vector4d chest_mount_quat_xyzw(double heading_rad) {
+  const double sh = std::sin(heading_rad), ch = std::cos(heading_rad);
+  Eigen::Matrix3d r;  // columns: phone X, Y, Z in ENU
+  r.col(0) = Eigen::Vector3d(ch, -sh, 0.0);
+  r.col(1) = Eigen::Vector3d(0.0, 0.0, 1.0);
+  r.col(2) = Eigen::Vector3d(-sh, -ch, 0.0);
+  const Eigen::Quaterniond q(r);
+  return Eigen::Vector4d(q.x(), q.y(), q.z(), q.w());
 }
 
 // ---------------------------------------------------------------- heading

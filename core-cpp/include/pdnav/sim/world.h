@@ -21,6 +21,11 @@ using Rng = std::mt19937_64;
 double uniform(Rng& rng, double a, double b);
 double gauss(Rng& rng, double sd);
 
+/// Orientation (unit quaternion x, y, z, w, phone -> ENU) of a chest-mounted phone, top edge up,
+/// camera forward, walking at `heading_rad` clockwise from north: phone -Z = forward =
+/// (sin h, cos h, 0), +Y = up, +X = forward x up. What an ideal rotation vector reports.
+Eigen::Vector4d chest_mount_quat_xyzw(double heading_rad);
+
 /// Rotation-vector heading error of a chest-worn phone: a slow random walk of the fused
 /// gyro/magnetometer yaw, piecewise-constant bias steps whenever the phone shifts in its
 /// holder, and spatial magnetic anomalies around structures (steel, cars, pylons) that the
