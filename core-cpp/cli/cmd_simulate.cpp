@@ -45,13 +45,7 @@ struct SimulateArgs {
   bool declare_start = false;
 };
 
-MetaSample meta(const std::string& key, const std::string& value) {
-  MetaSample m;
-  m.t_ns = 0;
-  m.key = key;
-  m.value = value;
-  return m;
-}
+MetaSample meta(const std::string& key, const std::string& value) { return {0, key, value}; }
 
 void write_truth_csv(const std::string& path, const terrain::SimulatedWalk& w) {
   std::ofstream f(path);

@@ -18,13 +18,7 @@
 namespace pdnav::fusion {
 namespace {
 
-MetaSample meta(TimeNs t, const std::string& key, const std::string& value) {
-  MetaSample m;
-  m.t_ns = t;
-  m.key = key;
-  m.value = value;
-  return m;
-}
+MetaSample meta(TimeNs t, const std::string& key, const std::string& value) { return {t, key, value}; }
 
 struct WalkResult {
   double fused_err_end_outage_m = 0.0, dr_err_end_outage_m = 0.0, fused_err_after_m = 0.0;

@@ -12,13 +12,7 @@
 namespace pdnav::fusion {
 namespace {
 
-MetaSample meta(TimeNs t, const std::string& key, const std::string& value) {
-  MetaSample m;
-  m.t_ns = t;
-  m.key = key;
-  m.value = value;
-  return m;
-}
+MetaSample meta(TimeNs t, const std::string& key, const std::string& value) { return {t, key, value}; }
 
 /// 100 Android step events walking north (phone flat, camera forward = north), start declared in
 /// Meta lines; returns the dead-reckoned distance from the start.

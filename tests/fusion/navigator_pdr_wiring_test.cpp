@@ -15,13 +15,7 @@
 namespace pdnav::fusion {
 namespace {
 
-MetaSample meta(TimeNs t, const std::string& key, const std::string& value) {
-  MetaSample m;
-  m.t_ns = t;
-  m.key = key;
-  m.value = value;
-  return m;
-}
+MetaSample meta(TimeNs t, const std::string& key, const std::string& value) { return {t, key, value}; }
 
 constexpr std::int64_t kUtc2026Ms = 1780272000000;  // 2026-06-01T00:00:00Z
 constexpr TimeNs kStepNs = 550 * kNsPerMs;

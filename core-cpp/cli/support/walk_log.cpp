@@ -17,13 +17,7 @@ std::string num(double v, int digits = 9) {
   return os.str();
 }
 
-MetaSample meta(const std::string& key, const std::string& value) {
-  MetaSample m;
-  m.t_ns = 0;
-  m.key = key;
-  m.value = value;
-  return m;
-}
+MetaSample meta(const std::string& key, const std::string& value) { return {0, key, value}; }
 
 }  // namespace
 

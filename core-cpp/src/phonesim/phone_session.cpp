@@ -137,12 +137,7 @@ RotationVectorSample rotation_for_heading(TimeNs t_ns, std::int64_t utc_ms, doub
   return out;
 }
 
-MetaSample meta(const std::string& key, const std::string& value) {
-  MetaSample m;
-  m.key = key;
-  m.value = value;
-  return m;
-}
+MetaSample meta(const std::string& key, const std::string& value) { return {0, key, value}; }
 
 std::string num(double v, int digits = 12) {
   std::ostringstream os;
