@@ -40,6 +40,8 @@ struct GnssArgs {
   bool clock_steps = false;  // robustness check: a 1 ms code-only clock step every epoch
   double kf_displacement_q_m2 = gnss::KalmanOptions{}.displacement_q_m2;
   double kf_fix_scale = gnss::KalmanOptions{}.fix_variance_scale;
+  std::string dynamics = gnss::kf_dynamics_name(gnss::KalmanOptions{}.dynamics);
+  double kf_accel_psd = kNaN;  // NaN = the dynamics' value
 };
 
 geo::Geodetic parse_truth(const std::string& s) {
@@ -237,6 +239,8 @@ void run_gnss(const GnssArgs& a) {
   options.smoothing.window_s = a.smoothing_window_s;
   options.kalman.displacement_q_m2 = a.kf_displacement_q_m2;
   options.kalman.fix_variance_scale = a.kf_fix_scale;
+  gnss::parse_kf_dynamics(a.dynamics, options.kalman.dynamics);  // validated by CLI11
+  options.kalman.accel_psd_h_m2ps3 = a.kf_accel_psd;
   gnss::GnssEngine engine(options, store, a.seed);
   std::int64_t raw_rows = 0;
   const std::vector<gnss::EpochSolution> sols = run(a, engine, raw_rows);
@@ -294,6 +298,11 @@ void register_gnss(CLI::App& app) {
                   "KF process noise added to each displacement, m^2 per epoch")->check(CLI::Range(0.0, 1e6));
   cmd->add_option("--kf-fix-scale", args->kf_fix_scale, "KF: multiplies the SPP covariance used as R")
       ->check(CLI::Range(1e-3, 1e6));
+  cmd->add_option("--dynamics", args->dynamics,
+                  "KF process noise: pedestrian (1 m^2/s^3) or vehicle (10 m^2/s^3), Groves 2013 Sec. 9.4.2.2")
+      ->check(CLI::IsMember({"pedestrian", "vehicle"}));
+  cmd->add_option("--kf-accel-psd", args->kf_accel_psd, "KF horizontal acceleration PSD, m^2/s^3 (overrides --dynamics)")
+      ->check(CLI::Range(1e-6, 1e6));
   cmd->add_option("--keep-every", args->keep_every, "robustness check: keep every N-th epoch (duty cycling)")
       ->check(CLI::Range(1, 3600));
   cmd->add_flag("--clock-steps", args->clock_steps,
