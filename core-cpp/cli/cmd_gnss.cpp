@@ -42,6 +42,8 @@ struct GnssArgs {
   double kf_fix_scale = gnss::KalmanOptions{}.fix_variance_scale;
   std::string dynamics = gnss::kf_dynamics_name(gnss::KalmanOptions{}.dynamics);
   double kf_accel_psd = kNaN;  // NaN = the dynamics' value
+  std::string spp_fde = "subsets";
+  bool spp_igg3 = gnss::SppOptions{}.robust_igg3;
 };
 
 geo::Geodetic parse_truth(const std::string& s) {
@@ -241,6 +243,8 @@ void run_gnss(const GnssArgs& a) {
   options.kalman.fix_variance_scale = a.kf_fix_scale;
   gnss::parse_kf_dynamics(a.dynamics, options.kalman.dynamics);  // validated by CLI11
   options.kalman.accel_psd_h_m2ps3 = a.kf_accel_psd;
+  options.spp.fde = a.spp_fde == "largest" ? gnss::SppFde::kLargestResidual : gnss::SppFde::kSubsets;
+  options.spp.robust_igg3 = a.spp_igg3;
   gnss::GnssEngine engine(options, store, a.seed);
   std::int64_t raw_rows = 0;
   const std::vector<gnss::EpochSolution> sols = run(a, engine, raw_rows);
@@ -303,6 +307,9 @@ void register_gnss(CLI::App& app) {
       ->check(CLI::IsMember({"pedestrian", "vehicle"}));
   cmd->add_option("--kf-accel-psd", args->kf_accel_psd, "KF horizontal acceleration PSD, m^2/s^3 (overrides --dynamics)")
       ->check(CLI::Range(1e-6, 1e6));
+  cmd->add_option("--spp-fde", args->spp_fde, "SPP FDE: subsets (leave-one/two-out, default) or largest (residual)")
+      ->check(CLI::IsMember({"subsets", "largest"}));
+  cmd->add_option("--spp-igg3", args->spp_igg3, "SPP IGG-III robust weights after the FDE (true/false)");
   cmd->add_option("--keep-every", args->keep_every, "robustness check: keep every N-th epoch (duty cycling)")
       ->check(CLI::Range(1, 3600));
   cmd->add_flag("--clock-steps", args->clock_steps,
