@@ -38,6 +38,7 @@ struct GnssArgs {
   std::uint64_t seed = 1;
   int keep_every = 1;  // robustness check: keep every N-th epoch (duty cycling)
   bool clock_steps = false;  // robustness check: a 1 ms code-only clock step every epoch
+  bool hw_discontinuities = false;  // robustness check: HardwareClockDiscontinuityCount changes every epoch
   double kf_displacement_q_m2 = gnss::KalmanOptions{}.displacement_q_m2;
   double kf_fix_scale = gnss::KalmanOptions{}.fix_variance_scale;
   std::string dynamics = gnss::kf_dynamics_name(gnss::KalmanOptions{}.dynamics);
@@ -122,6 +123,8 @@ std::vector<gnss::EpochSolution> run(const GnssArgs& a, gnss::GnssEngine& engine
       auto rows = gnss::rinex_epoch_to_raw(ep, reader.header(), skipped);
       if (a.clock_steps)
         for (auto& r : rows) r.full_bias_nanos -= (index % 2) * 1'000'000;
+      if (a.hw_discontinuities)
+        for (auto& r : rows) r.hardware_clock_discontinuity_count = index;
       for (auto& r : rows) {
         if (a.strip_adr) strip(r);
         engine.feed(r);
@@ -146,6 +149,7 @@ std::vector<gnss::EpochSolution> run(const GnssArgs& a, gnss::GnssEngine& engine
       if (raw->time_nanos != last_time_nanos) { ++index; last_time_nanos = raw->time_nanos; }
       if (index % a.keep_every != 0) continue;
       if (a.clock_steps && raw->full_bias_nanos != kMissingInt) raw->full_bias_nanos -= (index % 2) * 1'000'000;
+      if (a.hw_discontinuities) raw->hardware_clock_discontinuity_count = index;
       ++raw_rows;
       if (a.strip_adr) strip(*raw);
       engine.feed(*raw);
@@ -307,6 +311,8 @@ void register_gnss(CLI::App& app) {
       ->check(CLI::IsMember({"pedestrian", "vehicle"}));
   cmd->add_option("--kf-accel-psd", args->kf_accel_psd, "KF horizontal acceleration PSD, m^2/s^3 (overrides --dynamics)")
       ->check(CLI::Range(1e-6, 1e6));
+  cmd->add_flag("--hw-discontinuities", args->hw_discontinuities,
+                "robustness check: HardwareClockDiscontinuityCount changes on every epoch (no TDCP, KF clock reset)");
   cmd->add_option("--spp-fde", args->spp_fde, "SPP FDE: subsets (leave-one/two-out, default) or largest (residual)")
       ->check(CLI::IsMember({"subsets", "largest"}));
   cmd->add_option("--spp-igg3", args->spp_igg3, "SPP IGG-III robust weights after the FDE (true/false)");

@@ -190,7 +190,16 @@ struct GnssEngine::Impl {
 
   DisplacementSolution displacement(const std::vector<CarrierObservation>& obs, double dt) {
     DisplacementSolution none;
-    if (!has_prev || !have_pos) return none;
+    if (!have_pos) return none;
+    if (!has_prev) {
+      // no link to the previous epoch (gap, clock discontinuity): the Doppler velocity of this
+      // epoch alone is still a measurement for the kinematic KF (over a nominal 1 s)
+      if (!opt.use_doppler_fallback || !kf.initialized()) return none;
+      DisplacementSolution v = solve_doppler(obs, 1.0, last_pos, opt.tdcp);
+      merge(excluded, v.excluded);
+      if (!v.ok) count("doppler: " + v.reason);
+      return v;
+    }
     DisplacementSolution d = solve_tdcp(prev_obs, obs, dt, last_pos, opt.tdcp);
     merge(excluded, d.excluded);
     if (d.ok || !opt.use_doppler_fallback) {
@@ -222,7 +231,9 @@ struct GnssEngine::Impl {
         // constant-velocity prediction (the dynamics' acceleration PSD), then the Doppler
         // velocity of this epoch: with the velocity measured at both ends of a gap the
         // position follows the mean velocity instead of this epoch's velocity x dt
-        kf.coast(dt > 0.0 ? dt : 1.0);
+        // without a link the time since the last epoch still sets the prediction span
+        const double since_last_s = last_gps_ns != 0 ? static_cast<double>(sol.gps_ns - last_gps_ns) * 1e-9 : 0.0;
+        kf.coast(dt > 0.0 ? dt : (since_last_s > 0.0 ? since_last_s : 1.0));
         kf.shift_clock(-d_bias_m);
         if (disp.ok && disp.dt_s > 0.0) {
           const double t = disp.dt_s;
