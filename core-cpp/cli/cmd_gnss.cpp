@@ -304,7 +304,7 @@ void register_gnss(CLI::App& app) {
                   "carrier smoothing window of the code, s (RTCA DO-229: 100; 0 = raw code)")->check(CLI::Range(0.0, 3600.0));
   cmd->add_option("--kf-displacement-q", args->kf_displacement_q_m2,
                   "KF process noise added to each displacement, m^2 per epoch")->check(CLI::Range(0.0, 1e6));
-  cmd->add_option("--kf-fix-scale", args->kf_fix_scale, "KF: multiplies the SPP covariance used as R")
+  cmd->add_option("--kf-fix-scale", args->kf_fix_scale, "KF: multiplies the SPP covariance used as R, for fixes 1 s apart (AR(1) over longer gaps)")
       ->check(CLI::Range(1e-3, 1e6));
   cmd->add_option("--dynamics", args->dynamics,
                   "KF process noise: pedestrian (1 m^2/s^3) or vehicle (10 m^2/s^3), Groves 2013 Sec. 9.4.2.2")
