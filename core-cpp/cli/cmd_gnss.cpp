@@ -38,8 +38,13 @@ struct GnssArgs {
   std::uint64_t seed = 1;
   int keep_every = 1;  // robustness check: keep every N-th epoch (duty cycling)
   bool clock_steps = false;  // robustness check: a 1 ms code-only clock step every epoch
+  bool hw_discontinuities = false;  // robustness check: HardwareClockDiscontinuityCount changes every epoch
   double kf_displacement_q_m2 = gnss::KalmanOptions{}.displacement_q_m2;
   double kf_fix_scale = gnss::KalmanOptions{}.fix_variance_scale;
+  std::string dynamics = gnss::kf_dynamics_name(gnss::KalmanOptions{}.dynamics);
+  double kf_accel_psd = kNaN;  // NaN = the dynamics' value
+  std::string spp_fde = "subsets";
+  bool spp_igg3 = gnss::SppOptions{}.robust_igg3;
 };
 
 geo::Geodetic parse_truth(const std::string& s) {
@@ -118,6 +123,8 @@ std::vector<gnss::EpochSolution> run(const GnssArgs& a, gnss::GnssEngine& engine
       auto rows = gnss::rinex_epoch_to_raw(ep, reader.header(), skipped);
       if (a.clock_steps)
         for (auto& r : rows) r.full_bias_nanos -= (index % 2) * 1'000'000;
+      if (a.hw_discontinuities)
+        for (auto& r : rows) r.hardware_clock_discontinuity_count = index;
       for (auto& r : rows) {
         if (a.strip_adr) strip(r);
         engine.feed(r);
@@ -142,6 +149,7 @@ std::vector<gnss::EpochSolution> run(const GnssArgs& a, gnss::GnssEngine& engine
       if (raw->time_nanos != last_time_nanos) { ++index; last_time_nanos = raw->time_nanos; }
       if (index % a.keep_every != 0) continue;
       if (a.clock_steps && raw->full_bias_nanos != kMissingInt) raw->full_bias_nanos -= (index % 2) * 1'000'000;
+      if (a.hw_discontinuities) raw->hardware_clock_discontinuity_count = index;
       ++raw_rows;
       if (a.strip_adr) strip(*raw);
       engine.feed(*raw);
@@ -237,6 +245,10 @@ void run_gnss(const GnssArgs& a) {
   options.smoothing.window_s = a.smoothing_window_s;
   options.kalman.displacement_q_m2 = a.kf_displacement_q_m2;
   options.kalman.fix_variance_scale = a.kf_fix_scale;
+  gnss::parse_kf_dynamics(a.dynamics, options.kalman.dynamics);  // validated by CLI11
+  options.kalman.accel_psd_h_m2ps3 = a.kf_accel_psd;
+  options.spp.fde = a.spp_fde == "largest" ? gnss::SppFde::kLargestResidual : gnss::SppFde::kSubsets;
+  options.spp.robust_igg3 = a.spp_igg3;
   gnss::GnssEngine engine(options, store, a.seed);
   std::int64_t raw_rows = 0;
   const std::vector<gnss::EpochSolution> sols = run(a, engine, raw_rows);
@@ -292,8 +304,18 @@ void register_gnss(CLI::App& app) {
                   "carrier smoothing window of the code, s (RTCA DO-229: 100; 0 = raw code)")->check(CLI::Range(0.0, 3600.0));
   cmd->add_option("--kf-displacement-q", args->kf_displacement_q_m2,
                   "KF process noise added to each displacement, m^2 per epoch")->check(CLI::Range(0.0, 1e6));
-  cmd->add_option("--kf-fix-scale", args->kf_fix_scale, "KF: multiplies the SPP covariance used as R")
+  cmd->add_option("--kf-fix-scale", args->kf_fix_scale, "KF: multiplies the SPP covariance used as R, for fixes 1 s apart (AR(1) over longer gaps)")
       ->check(CLI::Range(1e-3, 1e6));
+  cmd->add_option("--dynamics", args->dynamics,
+                  "KF process noise: pedestrian (1 m^2/s^3) or vehicle (10 m^2/s^3), Groves 2013 Sec. 9.4.2.2")
+      ->check(CLI::IsMember({"pedestrian", "vehicle"}));
+  cmd->add_option("--kf-accel-psd", args->kf_accel_psd, "KF horizontal acceleration PSD, m^2/s^3 (overrides --dynamics)")
+      ->check(CLI::Range(1e-6, 1e6));
+  cmd->add_flag("--hw-discontinuities", args->hw_discontinuities,
+                "robustness check: HardwareClockDiscontinuityCount changes on every epoch (no TDCP, KF clock reset)");
+  cmd->add_option("--spp-fde", args->spp_fde, "SPP FDE: subsets (leave-one/two-out, default) or largest (residual)")
+      ->check(CLI::IsMember({"subsets", "largest"}));
+  cmd->add_option("--spp-igg3", args->spp_igg3, "SPP IGG-III robust weights after the FDE (true/false)");
   cmd->add_option("--keep-every", args->keep_every, "robustness check: keep every N-th epoch (duty cycling)")
       ->check(CLI::Range(1, 3600));
   cmd->add_flag("--clock-steps", args->clock_steps,

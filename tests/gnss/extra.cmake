@@ -14,3 +14,8 @@ set_tests_properties(gnss.cli_orbits_sp3_bar PROPERTIES LABELS "gnss;cli" TIMEOU
 add_test(NAME gnss.rtklib_reads_pdnav_rinex
   COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/gnss/check_rtklib_rinex.py" "$<TARGET_FILE:pdnav>" "${PDNAV_SHARED_DATA_DIR}")
 set_tests_properties(gnss.rtklib_reads_pdnav_rinex PROPERTIES LABELS "gnss;cli" TIMEOUT 300)
+
+# Issue 15 part A: the kinematic KF on the GSDC drive, continuous and duty cycled (5 s, no ADR).
+add_test(NAME gnss.cli_gsdc_kinematic_kf
+  COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/gnss/check_gsdc_kf.py" "$<TARGET_FILE:pdnav>" "${PDNAV_SHARED_DATA_DIR}")
+set_tests_properties(gnss.cli_gsdc_kinematic_kf PROPERTIES LABELS "gnss;cli" TIMEOUT 120)

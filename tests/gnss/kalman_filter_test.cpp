@@ -44,7 +44,8 @@ TEST(KalmanFilter, PosteriorResidualTestRejectsOutliers) {
   const Eigen::Vector3d before = kf.position().p_m;
   const KalmanUpdateResult bad = kf.update(geo::Ecef(kTruth.p_m + Eigen::Vector3d(60.0, 0, 0)), kFixCov, 0.0, 9.0);
   EXPECT_FALSE(bad.accepted);
-  EXPECT_GT(bad.max_normalised_residual, 36.0);
+  EXPECT_GT(bad.standardised_innovation, KalmanOptions{}.igg_k1);  // IGG-III: zero weight
+  EXPECT_EQ(bad.robust_weight, 0.0);
   EXPECT_EQ(kf.position().p_m, before);
   const KalmanUpdateResult good = kf.update(geo::Ecef(kTruth.p_m + Eigen::Vector3d(2.0, -1.0, 0)), kFixCov, 0.0, 9.0);
   EXPECT_TRUE(good.accepted);
@@ -74,7 +75,11 @@ TEST(KalmanFilter, CoastingGrowsTheCovarianceAndBadInputIsIgnored) {
   ASSERT_TRUE(kf.initialized());
   const double before = kf.position_cov_ecef().trace();
   kf.coast(10.0);
-  EXPECT_NEAR(kf.position_cov_ecef().trace(), before + 3 * 4.0 * 10.0, 1e-6);
+  // constant velocity: P_rr += P_vv dt^2 + S dt^3 / 3 (trace of S: 2 horizontal + 0.1 vertical)
+  const KalmanOptions o;
+  const double s_trace = kf_accel_psd_m2ps3(o.dynamics) * (2.0 + o.vertical_psd_fraction);
+  EXPECT_NEAR(kf.position_cov_ecef().trace(), before + 3 * o.initial_velocity_var_m2ps2 * 100.0 + s_trace * 1000.0 / 3.0,
+              1e-6);
   kf.predict(Eigen::Vector3d(kNaN, 0, 0), Eigen::Matrix3d::Identity(), 0.0, 1.0);
   kf.update(geo::Ecef(kNaN, 0, 0), kFixCov, 0.0, 9.0);
   kf.update(kTruth, kFixCov, kNaN, 9.0);
@@ -83,6 +88,86 @@ TEST(KalmanFilter, CoastingGrowsTheCovarianceAndBadInputIsIgnored) {
   EXPECT_TRUE(kf.state().allFinite());
   EXPECT_TRUE(kf.covariance().allFinite());
   EXPECT_LT((kf.position().p_m - kTruth.p_m).norm(), 1e-9);
+}
+
+TEST(KalmanFilter, WalkerPosteriorTestStillRejectsWithoutIgg3) {
+  KalmanOptions opt;
+  opt.robust_igg3 = false;
+  RobustKalman kf(opt);
+  kf.reset(kTruth, Eigen::Matrix3d::Identity() * 1.0, 0.0, 1.0);
+  kf.predict(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity() * 1e-4, 0.0, 1e-4);
+  const KalmanUpdateResult bad = kf.update(geo::Ecef(kTruth.p_m + Eigen::Vector3d(60.0, 0, 0)), kFixCov, 0.0, 9.0);
+  EXPECT_FALSE(bad.accepted);
+  EXPECT_GT(bad.max_normalised_residual, 36.0);
+}
+
+TEST(KalmanFilter, Igg3WeightsFollowYang2002) {
+  EXPECT_EQ(igg3_weight(0.0, 1.5, 3.0), 1.0);
+  EXPECT_EQ(igg3_weight(-1.5, 1.5, 3.0), 1.0);
+  EXPECT_NEAR(igg3_weight(2.0, 1.5, 3.0), 1.5 / 2.0 * (1.0 / 1.5) * (1.0 / 1.5), 1e-12);
+  EXPECT_EQ(igg3_weight(3.01, 1.5, 3.0), 0.0);
+  EXPECT_EQ(igg3_weight(kNaN, 1.5, 3.0), 0.0);
+  // a 2.2-sigma innovation is down-weighted, not rejected
+  RobustKalman kf;
+  kf.reset(kTruth, Eigen::Matrix3d::Identity() * 1.0, 0.0, 1.0);
+  const double sd = std::sqrt(1.0 + 9.0 * KalmanOptions{}.fix_variance_scale);
+  const double e = 2.2 * sd * 2.0;  // sqrt(nu' S^-1 nu / 4) = 2.2 for one axis
+  const KalmanUpdateResult u = kf.update(geo::Ecef(kTruth.p_m + Eigen::Vector3d(e, 0, 0)), kFixCov, 0.0, 1e-6);
+  EXPECT_TRUE(u.accepted);
+  EXPECT_NEAR(u.standardised_innovation, 2.2, 0.05);
+  EXPECT_GT(u.robust_weight, 0.0);
+  EXPECT_LT(u.robust_weight, 1.0);
+}
+
+TEST(KalmanFilter, FixScaleFollowsTheAr1CorrelationOverTheFixInterval) {
+  const KalmanOptions o;  // 4 at 1 s
+  EXPECT_NEAR(fix_variance_scale_for(o, 1.0), 4.0, 1e-12);
+  EXPECT_NEAR(fix_variance_scale_for(o, 5.0), (1 + std::pow(0.6, 5)) / (1 - std::pow(0.6, 5)), 1e-12);
+  EXPECT_GT(fix_variance_scale_for(o, 0.5), 4.0);
+  EXPECT_LT(fix_variance_scale_for(o, 30.0), 1.001);
+  KalmanOptions none;
+  none.fix_variance_scale = 1.0;
+  EXPECT_EQ(fix_variance_scale_for(none, 5.0), 1.0);
+}
+
+TEST(KalmanFilter, DopplerVelocityAtBothEndsOfAGapFollowsAnAcceleratingTrack) {
+  // constant 2 m/s^2 along the first ECEF-ish axis; a velocity measured every 5 s only
+  KalmanOptions opt;
+  opt.dynamics = KfDynamics::kVehicle;
+  RobustKalman kf(opt);
+  const Eigen::Vector3d a(2.0, 0.0, 0.0), v0(10.0, 0.0, 0.0);
+  kf.reset(kTruth, Eigen::Matrix3d::Identity() * 0.01, 0.0, 1.0);
+  ASSERT_TRUE(kf.update_velocity(v0, Eigen::Matrix3d::Identity() * 1e-4, kNaN, kNaN).accepted);
+  const double dt = 5.0;
+  kf.coast(dt);
+  const Eigen::Vector3d end_before_update = kf.position().p_m;
+  ASSERT_TRUE(kf.update_velocity(v0 + a * dt, Eigen::Matrix3d::Identity() * 1e-4, kNaN, kNaN).accepted);
+  const Eigen::Vector3d truth = kTruth.p_m + v0 * dt + 0.5 * a * dt * dt;  // 25 m ahead of v0 * dt
+  EXPECT_GT((end_before_update - truth).norm(), 20.0);
+  // the cross-covariance of the white-acceleration model moves the position by the mean velocity
+  EXPECT_LT((kf.position().p_m - truth).norm(), 1.0);
+  EXPECT_NEAR(kf.velocity_ecef_mps().x(), 20.0, 0.1);
+}
+
+TEST(KalmanFilter, DynamicsOptionSetsTheAccelerationPsd) {
+  KfDynamics d = KfDynamics::kVehicle;
+  ASSERT_TRUE(parse_kf_dynamics("pedestrian", d));
+  EXPECT_EQ(d, KfDynamics::kPedestrian);
+  ASSERT_TRUE(parse_kf_dynamics("vehicle", d));
+  EXPECT_EQ(d, KfDynamics::kVehicle);
+  EXPECT_FALSE(parse_kf_dynamics("boat", d));
+  EXPECT_EQ(kf_accel_psd_m2ps3(KfDynamics::kPedestrian), 1.0);
+  EXPECT_EQ(kf_accel_psd_m2ps3(KfDynamics::kVehicle), 10.0);
+  KalmanOptions ped, car;
+  ped.dynamics = KfDynamics::kPedestrian;
+  car.dynamics = KfDynamics::kVehicle;
+  RobustKalman a(ped), b(car);
+  a.reset(kTruth, Eigen::Matrix3d::Identity(), 0.0, 1.0);
+  b.reset(kTruth, Eigen::Matrix3d::Identity(), 0.0, 1.0);
+  a.coast(1.0);
+  b.coast(1.0);
+  EXPECT_NEAR(b.velocity_cov_ecef().trace() - car.initial_velocity_var_m2ps2 * 3,
+              10.0 * (a.velocity_cov_ecef().trace() - ped.initial_velocity_var_m2ps2 * 3), 1e-6);
 }
 
 }  // namespace

@@ -44,6 +44,7 @@ struct GnssEngine::Impl {
   geo::LocalFrame frame;
   TimeNs last_t_ns = 0;
   std::int64_t last_gps_ns = 0;
+  std::int64_t last_fix_gps_ns = 0;  // receive time of the last SPP fix given to the KF
   int epochs_since_update = 0;
   int last_sats_used = 0;
   bool have_clock_system = false;
@@ -160,7 +161,7 @@ struct GnssEngine::Impl {
     if (disp.ok) {
       disp.clock_change_m -= d_bias_ns * 1e-9 * kSpeedOfLight_mps;
     }
-    run_filter(spp, disp, dt, sol);
+    run_filter(spp, disp, dt, d_bias_ns * 1e-9 * kSpeedOfLight_mps, sol);
     if (disp.ok) {
       sol.tdcp_ok = disp.source == "tdcp";
       sol.disp_source = disp.source;
@@ -189,7 +190,16 @@ struct GnssEngine::Impl {
 
   DisplacementSolution displacement(const std::vector<CarrierObservation>& obs, double dt) {
     DisplacementSolution none;
-    if (!has_prev || !have_pos) return none;
+    if (!have_pos) return none;
+    if (!has_prev) {
+      // no link to the previous epoch (gap, clock discontinuity): the Doppler velocity of this
+      // epoch alone is still a measurement for the kinematic KF (over a nominal 1 s)
+      if (!opt.use_doppler_fallback || !kf.initialized()) return none;
+      DisplacementSolution v = solve_doppler(obs, 1.0, last_pos, opt.tdcp);
+      merge(excluded, v.excluded);
+      if (!v.ok) count("doppler: " + v.reason);
+      return v;
+    }
     DisplacementSolution d = solve_tdcp(prev_obs, obs, dt, last_pos, opt.tdcp);
     merge(excluded, d.excluded);
     if (d.ok || !opt.use_doppler_fallback) {
@@ -202,17 +212,37 @@ struct GnssEngine::Impl {
     return v;
   }
 
-  void run_filter(const SppSolution& spp, const DisplacementSolution& disp, double dt, EpochSolution& sol) {
+  /// d_bias_m: c * change of FullBiasNanos + BiasNanos since the previous epoch. The KF clock is
+  /// the SPP clock (receive time corrected by that bias); its drift is the hardware clock's
+  /// (what Doppler and carrier see), so a prediction moves the clock by drift * dt - d_bias_m.
+  void run_filter(const SppSolution& spp, const DisplacementSolution& disp, double dt, double d_bias_m,
+                  EpochSolution& sol) {
     if (kf.initialized()) {
-      if (disp.ok) {
+      if (disp.ok && disp.source == "tdcp") {
         // the displacement's own covariance plus a process noise growing as dt^3 (white
         // acceleration, Bar-Shalom 2001 Sec. 6.2): q per 1 s epoch, 125 q over a 5 s gap
-        // (duty cycling: a Doppler velocity times 5 s misses every turn)
         const double span = std::max(1.0, disp.dt_s > 0.0 ? disp.dt_s : dt);
         const Eigen::Matrix3d q = Eigen::Matrix3d::Identity() * opt.kalman.displacement_q_m2 * (span * span * span - 1.0);
-        kf.predict(disp.disp_ecef_m, disp.cov_ecef_m2 + q, disp.clock_change_m, disp.clock_change_var_m2);
+        kf.predict(disp.disp_ecef_m, disp.cov_ecef_m2 + q, disp.clock_change_m, disp.clock_change_var_m2, span);
+        // the mean velocity over the interval keeps the velocity state for later coasting
+        kf.set_velocity(disp.disp_ecef_m / span, disp.cov_ecef_m2 / (span * span),
+                        (disp.clock_change_m + d_bias_m) / span, disp.clock_change_var_m2 / (span * span));
+      } else {
+        // constant-velocity prediction (the dynamics' acceleration PSD), then the Doppler
+        // velocity of this epoch: with the velocity measured at both ends of a gap the
+        // position follows the mean velocity instead of this epoch's velocity x dt
+        // without a link the time since the last epoch still sets the prediction span
+        const double since_last_s = last_gps_ns != 0 ? static_cast<double>(sol.gps_ns - last_gps_ns) * 1e-9 : 0.0;
+        kf.coast(dt > 0.0 ? dt : (since_last_s > 0.0 ? since_last_s : 1.0));
+        kf.shift_clock(-d_bias_m);
+        if (disp.ok && disp.dt_s > 0.0) {
+          const double t = disp.dt_s;
+          const KalmanUpdateResult v = kf.update_velocity(disp.disp_ecef_m / t, disp.cov_ecef_m2 / (t * t),
+                                                          (disp.clock_change_m + d_bias_m) / t,
+                                                          disp.clock_change_var_m2 / (t * t));
+          if (!v.accepted) count("kf: velocity rejected (robust test)");
+        }
       }
-      else kf.coast(dt > 0.0 ? dt : 1.0);
     }
     ++epochs_since_update;
     if (spp.ok) {
@@ -231,10 +261,14 @@ struct GnssEngine::Impl {
       // the a-priori C/N0 model does not know the multipath of a moving phone, the residuals do
       const int dof = static_cast<int>(spp.used.size()) - 4 - static_cast<int>(spp.isb_m.size());
       const double vf = opt.scale_fix_by_variance_factor && dof > 0 ? std::max(1.0, spp.chi2 / dof) : 1.0;
-      const KalmanUpdateResult u = kf.update(spp.pos, spp.pos_cov_ecef * vf, spp.clock_m, spp.clock_var_m2 * vf);
+      const double since_fix_s = last_fix_gps_ns != 0 ? static_cast<double>(sol.gps_ns - last_fix_gps_ns) * 1e-9 : 1.0;
+      last_fix_gps_ns = sol.gps_ns;
+      const KalmanUpdateResult u =
+          kf.update(spp.pos, spp.pos_cov_ecef * vf, spp.clock_m, spp.clock_var_m2 * vf, since_fix_s);
       sol.kf_update_accepted = u.accepted;
       if (u.accepted) epochs_since_update = 0;
-      else count("kf: SPP fix rejected (posterior residual^2/var > 36)");
+      else count("kf: SPP fix rejected (robust test)");
+      if (u.accepted && u.robust_weight < 1.0) count("kf: SPP fix down-weighted (IGG-III)");
       if (u.reset && was_initialized) count("kf: reset to the SPP fix");
     }
     if (!kf.initialized()) return;
@@ -242,6 +276,7 @@ struct GnssEngine::Impl {
     sol.kf = kf.position();
     sol.clock_m = kf.clock_m();
     sol.kf_cov_enu = kf.position_cov_enu();
+    sol.kf_vel_enu_mps = geo::ecef_to_enu_rotation(geo::to_geodetic(kf.position())) * kf.velocity_ecef_mps();
     last_pos = kf.position();
     if (!have_frame) { frame = geo::LocalFrame(geo::to_geodetic(last_pos)); have_frame = true; }
   }
@@ -312,6 +347,7 @@ void GnssEngine::reset() {
   m.have_pos = false;
   m.epochs_since_update = 0;
   m.have_clock_system = false;
+  m.last_fix_gps_ns = 0;
 }
 
 Estimate GnssEngine::estimate() const {

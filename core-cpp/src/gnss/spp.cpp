@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 
 #include "pdnav/geo/units.h"
+#include "pdnav/gnss/kalman.h"
 
 namespace pdnav::gnss {
 namespace {
@@ -111,8 +113,10 @@ struct LsResult {
 };
 
 /// Gauss-Newton on the given observations; masked satellites are dropped from the fit.
+/// `var_scale` (may be null) multiplies each observation's variance (robust reweighting).
 LsResult iterate_ls(const std::vector<const SppObservation*>& obs, const Layout& l, Eigen::VectorXd x,
-                    double tow_s, const KlobucharParams* klob, const SppOptions& opt) {
+                    double tow_s, const KlobucharParams* klob, const SppOptions& opt,
+                    const std::vector<double>* var_scale = nullptr) {
   LsResult res;
   const int n = static_cast<int>(obs.size());
   for (int it = 0; it < opt.max_iterations; ++it) {
@@ -122,6 +126,7 @@ LsResult iterate_ls(const std::vector<const SppObservation*>& obs, const Layout&
     int used = 0;
     for (int i = 0; i < n; ++i) {
       res.rows.push_back(model_row(*obs[i], x, l, tow_s, klob, opt));
+      if (var_scale != nullptr) res.rows.back().var_m2 *= (*var_scale)[static_cast<std::size_t>(i)];
       const Row& r = res.rows.back();
       if (r.masked) continue;
       h.block<1, 3>(i, 0) = -r.los.transpose();
@@ -142,7 +147,10 @@ LsResult iterate_ls(const std::vector<const SppObservation*>& obs, const Layout&
     if (dx.head<3>().norm() < opt.convergence_m && x.head<3>().norm() > kNearSurfaceMinM) {
       res.cov = ldlt.solve(Eigen::MatrixXd::Identity(l.cols, l.cols));
       // final rows at the converged state
-      for (int i = 0; i < n; ++i) res.rows[static_cast<std::size_t>(i)] = model_row(*obs[i], x, l, tow_s, klob, opt);
+      for (int i = 0; i < n; ++i) {
+        res.rows[static_cast<std::size_t>(i)] = model_row(*obs[i], x, l, tow_s, klob, opt);
+        if (var_scale != nullptr) res.rows[static_cast<std::size_t>(i)].var_m2 *= (*var_scale)[static_cast<std::size_t>(i)];
+      }
       res.x = x;
       res.ok = true;
       return res;
@@ -236,6 +244,87 @@ std::size_t worst_satellite(const LsResult& ls) {
   return worst;
 }
 
+/// Standardised residuals t_i = v_i / sqrt(Q_vv,ii), Q_vv = W^-1 - H N^-1 H' (Baarda's w-test
+/// statistic); 0 for masked rows.
+std::vector<double> standardised_residuals(const LsResult& ls, const std::vector<const SppObservation*>& obs,
+                                           const Layout& l) {
+  std::vector<double> t(obs.size(), 0.0);
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    const Row& r = ls.rows[i];
+    if (r.masked) continue;
+    Eigen::VectorXd h = Eigen::VectorXd::Zero(l.cols);
+    h.head<3>() = -r.los;
+    h(3) = 1.0;
+    if (isb_col(l, obs[i]->sat.sys) >= 0) h(isb_col(l, obs[i]->sat.sys)) = 1.0;
+    const double qvv = r.var_m2 - h.dot(ls.cov * h);
+    t[i] = r.residual_m / std::sqrt(std::max(qvv, 1e-6 * r.var_m2));
+  }
+  return t;
+}
+
+struct SubsetFit {
+  bool ok = false;
+  double ratio = 0.0;  // chi2 / quantile: < 1 passes the test
+};
+
+/// Refit without the satellites `drop` (indices into obs) and apply the chi-square test.
+SubsetFit fit_without(const std::vector<const SppObservation*>& obs, const std::vector<std::size_t>& drop,
+                      const Eigen::VectorXd& x0, double tow_s, const KlobucharParams* klob, const SppOptions& opt) {
+  std::vector<const SppObservation*> sub;
+  for (std::size_t i = 0; i < obs.size(); ++i)
+    if (std::find(drop.begin(), drop.end(), i) == drop.end()) sub.push_back(obs[i]);
+  const Layout l = make_layout(sub);
+  SubsetFit f;
+  if (static_cast<int>(sub.size()) < l.cols + 1) return f;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(l.cols);
+  x.head<4>() = x0.head<4>();
+  const LsResult ls = iterate_ls(sub, l, x, tow_s, klob, opt);
+  if (!ls.ok) return f;
+  double chi2 = 0.0;
+  int used = 0;
+  for (const Row& r : ls.rows) {
+    if (r.masked) continue;
+    chi2 += r.residual_m * r.residual_m / r.var_m2;
+    ++used;
+  }
+  const int dof = used - l.cols;
+  if (dof < 1) return f;
+  f.ok = true;
+  f.ratio = chi2 / chi_square_quantile(opt.fde_false_alarm, dof);
+  return f;
+}
+
+/// The satellites to exclude (indices into obs) when the full set fails the chi-square test:
+/// leave-one-out on the `fde_candidates` worst standardised residuals; if none passes, every
+/// pair of them; the passing subset with the smallest chi2/quantile wins. If nothing passes,
+/// the single exclusion with the smallest ratio (the loop then goes on).
+std::vector<std::size_t> subset_exclusion(const LsResult& ls, const std::vector<const SppObservation*>& obs,
+                                          const Layout& l, double tow_s, const KlobucharParams* klob,
+                                          const SppOptions& opt, int room) {
+  const std::vector<double> t = standardised_residuals(ls, obs, l);
+  std::vector<std::size_t> cand;
+  for (std::size_t i = 0; i < obs.size(); ++i)
+    if (!ls.rows[i].masked) cand.push_back(i);
+  std::sort(cand.begin(), cand.end(), [&](std::size_t a, std::size_t b) { return std::fabs(t[a]) > std::fabs(t[b]); });
+  if (static_cast<int>(cand.size()) > opt.fde_candidates) cand.resize(static_cast<std::size_t>(std::max(opt.fde_candidates, 1)));
+  std::vector<std::size_t> best_single;
+  double best_single_ratio = std::numeric_limits<double>::infinity();
+  for (std::size_t c : cand) {
+    const SubsetFit f = fit_without(obs, {c}, ls.x, tow_s, klob, opt);
+    if (f.ok && f.ratio < best_single_ratio) { best_single_ratio = f.ratio; best_single = {c}; }
+  }
+  if (best_single_ratio < 1.0 || room < 2) return best_single.empty() ? std::vector<std::size_t>{worst_satellite(ls)} : best_single;
+  std::vector<std::size_t> best_pair;
+  double best_pair_ratio = 1.0;
+  for (std::size_t a = 0; a < cand.size(); ++a)
+    for (std::size_t b = a + 1; b < cand.size(); ++b) {
+      const SubsetFit f = fit_without(obs, {cand[a], cand[b]}, ls.x, tow_s, klob, opt);
+      if (f.ok && f.ratio < best_pair_ratio) { best_pair_ratio = f.ratio; best_pair = {cand[a], cand[b]}; }
+    }
+  if (!best_pair.empty()) return best_pair;
+  return best_single.empty() ? std::vector<std::size_t>{worst_satellite(ls)} : best_single;
+}
+
 /// Upper quantile z of the standard normal: P(Z > z) = p (bisection on erfc).
 double normal_upper_quantile(double p) {
   double lo = -10.0, hi = 10.0;
@@ -317,6 +406,37 @@ SppSolution solve_spp(const std::vector<SppObservation>& all, const geo::Ecef& i
     if (!fill_dop(ls, obs, l, s) || !(s.gdop < opt.max_gdop)) return fail("singular geometry (GDOP)");
     const int dof = used - l.cols;
     const bool test_fails = dof >= 1 && s.chi2 > chi_square_quantile(opt.fde_false_alarm, dof);
+    if (!test_fails && opt.robust_igg3 && dof >= 1) {
+      // IGG-III reweighting of the consistent set (moderate multipath the test lets through)
+      std::vector<double> scale(obs.size(), 1.0);
+      LsResult cur = ls;
+      bool changed = false;
+      for (int pass = 0; pass < 5; ++pass) {
+        const std::vector<double> t = standardised_residuals(cur, obs, l);
+        bool moved = false;
+        for (std::size_t i = 0; i < obs.size(); ++i) {
+          if (cur.rows[i].masked) continue;
+          // a zero weight becomes a 1e4 variance factor (100 sigma): kept in the geometry, no pull
+          const double w = std::max(igg3_weight(t[i], opt.igg_k0, opt.igg_k1), 1e-4);
+          const double ns = scale[i] / w;
+          if (std::fabs(ns / scale[i] - 1.0) > 1e-3) moved = true;
+          scale[i] = std::min(ns, 1e4);
+        }
+        if (!moved) break;
+        const LsResult next = iterate_ls(obs, l, cur.x, gps_tow_s, klob, no_mask, &scale);
+        if (!next.ok) break;
+        cur = next;
+        changed = true;
+      }
+      if (changed) {
+        SppSolution r = to_solution(cur, obs, l);
+        if (fill_dop(cur, obs, l, r) && r.gdop < opt.max_gdop) {
+          for (double v : scale) r.downweighted += v > 1.0 + 1e-9 ? 1 : 0;
+          if (r.downweighted > 0) excluded["spp: IGG-III down-weighted"] += r.downweighted;
+          s = r;
+        }
+      }
+    }
     if (!test_fails || static_cast<int>(fde.size()) >= opt.max_fde_exclusions || dof < 2) {
       s.excluded = excluded;
       s.excluded_fde = fde;
@@ -328,10 +448,17 @@ SppSolution solve_spp(const std::vector<SppObservation>& all, const geo::Ecef& i
       }
       return s;
     }
-    const std::size_t worst = worst_satellite(ls);
-    fde.push_back(obs[worst]->sat);
-    ++excluded["spp: FDE residual test"];
-    obs.erase(obs.begin() + static_cast<std::ptrdiff_t>(worst));
+    std::vector<std::size_t> drop;
+    if (opt.fde == SppFde::kSubsets)
+      drop = subset_exclusion(ls, obs, l, gps_tow_s, klob, opt, std::min(opt.max_fde_exclusions - static_cast<int>(fde.size()), dof - 1));
+    else
+      drop = {worst_satellite(ls)};
+    std::sort(drop.rbegin(), drop.rend());  // erase from the back
+    for (std::size_t i : drop) {
+      fde.push_back(obs[i]->sat);
+      ++excluded["spp: FDE residual test"];
+      obs.erase(obs.begin() + static_cast<std::ptrdiff_t>(i));
+    }
   }
 }
 

@@ -27,7 +27,7 @@ struct GnssOptions {
   SmoothingOptions smoothing;        // Hatch carrier smoothing, 100 s (RTCA DO-229); window_s = 0 = raw code
   SppOptions spp;                    // WLS + ISB + FDE (Walker 2019 Eq. 1)
   TdcpOptions tdcp;                  // a = 10, b = 150^2 (Walker 2019 Sec. 2.4)
-  KalmanOptions kalman;              // residual test 36 (Walker 2019 Sec. 2.5)
+  KalmanOptions kalman;              // residual test 36 (Walker 2019 Sec. 2.5); dynamics (Groves 2013)
   double max_epoch_gap_s = 10.0;     // a longer gap drops the previous epoch (no TDCP across it)
   bool use_doppler_fallback = true;  // pseudorange-rate velocity when TDCP is unavailable
   int lost_after_epochs = 30;        // status kLost after this many epochs without an SPP update
@@ -54,6 +54,7 @@ struct EpochSolution {
   bool kf_ok = false;
   bool kf_update_accepted = false;
   Eigen::Matrix3d kf_cov_enu = Eigen::Matrix3d::Identity();  // m^2, at the KF position
+  Eigen::Vector3d kf_vel_enu_mps = Eigen::Vector3d::Zero();  // KF velocity, ENU at the KF position
   double clock_m = 0.0;                     // KF receiver clock (reference system), m
   int sats_used = 0;                        // in SPP
   int sats_tracked = 0;                     // rows of the epoch

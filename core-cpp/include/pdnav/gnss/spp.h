@@ -27,12 +27,26 @@ double cn0_elevation_variance(double a, double b, double cn0_dbhz, double el_rad
 /// error < 3 % for dof >= 1 at P_fa 1e-3..0.05, erring high, i.e. slightly conservative).
 double chi_square_quantile(double p_false_alarm, int dof);
 
+/// How the FDE picks what to exclude when the chi-square test fails.
+enum class SppFde {
+  kLargestResidual,  // drop the largest normalised residual, refit, repeat (classic RAIM)
+  kSubsets,          // test subsets: leave-one-out, then leave-two-out, on the candidates with the
+                     // largest standardised residuals (Baarda w-test ranking), chi-square on each
+};
+
 struct SppOptions {
   double elevation_mask_deg = 10.0;     // Walker 2019 Sec. 2.2 (10 deg mask)
   double code_var_a_m2 = 4.0;           // a of cn0_elevation_variance for code [m^2] (2 m at zenith, strong signal)
   double code_var_b_m2 = 160000.0;      // b [m^2 (Hz)]: 4 m at 40 dB-Hz, 22 m at 25 dB-Hz (phone code noise)
   double fde_false_alarm = 1e-3;        // chi-square test probability (RAIM P_fa)
   int max_fde_exclusions = 4;           // stop excluding after this many satellites
+  SppFde fde = SppFde::kSubsets;        // two 30-60 m multipath faults defeat kLargestResidual (tests)
+  int fde_candidates = 6;               // subsets are drawn from this many worst standardised residuals
+  // After the FDE: IGG-III equivalent weights on the standardised residuals (Yang, Song & Xu
+  // 2002, J. Geodesy 76:353-358), k0 = 1.5, k1 = 3.0; iterated reweighting, at most 5 passes.
+  bool robust_igg3 = true;
+  double igg_k0 = 1.5;
+  double igg_k1 = 3.0;
   int max_iterations = 12;
   double convergence_m = 1e-4;
   double max_gdop = 30.0;               // worse geometry is rejected as singular
@@ -67,7 +81,8 @@ struct SppSolution {
   std::vector<SatId> excluded_fde;
   std::map<std::string, std::int64_t> excluded;    // reason -> count (mask, single-sat system, FDE)
   int iterations = 0;
-  double chi2 = 0.0;                               // weighted sum of squared residuals
+  double chi2 = 0.0;                               // weighted sum of squared residuals (robust weights in)
+  int downweighted = 0;                            // satellites with an IGG-III weight < 1
   std::map<Constellation, int> used_by_sys() const;
 };
 
