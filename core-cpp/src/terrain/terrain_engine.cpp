@@ -907,7 +907,8 @@ struct TerrainEngine::Impl {
   /// smoothed twice with [1 2 1]/4, cut at valleys deeper than mode_valley_fraction of the
   /// smaller neighbouring peak; groups lighter than mode_min_weight join their neighbour
   /// across the shallower cut, groups closer than mode_min_separation_m merge.
-  /// Empty: one mode, the estimate itself (a cloud narrower than mode_min_separation_m / 4).
+  /// Empty: one mode, the estimate itself (a cloud narrower than mode_min_separation_m / 4, or
+  /// a histogram without a valley: then the per-bin moments are never computed).
   std::vector<Moments> find_modes(const Eigen::Vector2d& mean, const Eigen::Matrix2d& cov) const {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
     const double major_sd = std::sqrt(std::max(0.0, eig.eigenvalues()(1)));
@@ -917,19 +918,22 @@ struct TerrainEngine::Impl {
     // +-4 sigma along the major axis (one pass; particles beyond go to the end bins).
     const double lo = -4.0 * major_sd, hi = 4.0 * major_sd;
     const double scale = kBins / (hi - lo) * (1.0 - 1e-9);
+    // Bin of a particle, in float (a bin is 1/6 sigma wide); NaN and far-out particles land
+    // in the end bins.
+    const auto me = static_cast<float>(mean.x()), mn = static_cast<float>(mean.y());
+    const auto ux = static_cast<float>(u.x() * scale), uy = static_cast<float>(u.y() * scale);
+    const auto f0 = static_cast<float>(-lo * scale);
+    const auto bin_of = [&](std::size_t i) {
+      const float f = (p.e[i] - me) * ux + (p.n[i] - mn) * uy + f0;
+      return f > 0.0f ? (f < kBins - 1.0f ? static_cast<int>(f) : kBins - 1) : 0;
+    };
+    // Pass 1: the weight histogram alone. The per-bin moments (pass 2) are needed only when
+    // the histogram has a valley, i.e. when the cloud may be multimodal.
     std::array<double, kBins> h{};
-    std::array<Moments, kBins> bin{};
-    Moments all;
-    for (std::size_t i = 0; i < count; ++i) {
-      if (!(w[i] > 0.0f)) continue;
-      const double x = (p.e[i] - mean.x()) * u.x() + (p.n[i] - mean.y()) * u.y();
-      const double f = (x - lo) * scale;  // NaN and far-out particles land in the end bins
-      const int b = f > 0.0 ? (f < kBins - 1.0 ? static_cast<int>(f) : kBins - 1) : 0;
-      h[b] += w[i];
-      bin[b].add(w[i], p.e[i], p.n[i]);
-    }
-    for (const Moments& m : bin) all.add(m);
-    if (!(all.w > 0)) return {};
+    for (std::size_t i = 0; i < count; ++i) h[static_cast<std::size_t>(bin_of(i))] += w[i];
+    double all_w = 0.0;
+    for (double v : h) all_w += v;
+    if (!(all_w > 0)) return {};
     for (int pass = 0; pass < 2; ++pass) {
       std::array<double, kBins> g{};
       for (int b = 0; b < kBins; ++b)
@@ -951,13 +955,17 @@ struct TerrainEngine::Impl {
         peak = valley = b;
       }
     }
+    if (cuts.empty()) return {};  // one group: the estimate itself
+    std::array<Moments, kBins> bin{};
+    for (std::size_t i = 0; i < count; ++i)
+      if (w[i] > 0.0f) bin[static_cast<std::size_t>(bin_of(i))].add(w[i], p.e[i], p.n[i]);
     std::vector<Moments> groups;
     std::vector<double> cut_depth;  // between groups[k] and groups[k + 1]
     int start = 0;
     for (std::size_t c = 0; c <= cuts.size(); ++c) {
       const int end = c < cuts.size() ? cuts[c] : kBins;
       Moments m;
-      for (int b = start; b < end; ++b) m.add(bin[b]);
+      for (int b = start; b < end; ++b) m.add(bin[static_cast<std::size_t>(b)]);
       groups.push_back(m);
       if (c < cuts.size()) cut_depth.push_back(depth[c]);
       start = end;
@@ -970,7 +978,7 @@ struct TerrainEngine::Impl {
     for (bool changed = true; changed && groups.size() > 1;) {
       changed = false;
       for (std::size_t k = 0; k < groups.size() && groups.size() > 1; ++k) {
-        if (groups[k].w >= opt.mode_min_weight * all.w) continue;
+        if (groups[k].w >= opt.mode_min_weight * all_w) continue;
         if (k == 0) merge(0);
         else if (k + 1 == groups.size()) merge(k - 1);
         else merge(cut_depth[k - 1] > cut_depth[k] ? k - 1 : k);  // across the shallower cut
@@ -1114,6 +1122,19 @@ std::vector<Eigen::Vector2d> TerrainEngine::particles_en(std::size_t max) const 
     const std::size_t i = k * n / take;
     out.emplace_back(impl_->p.e[i], impl_->p.n[i]);
   }
+  return out;
+}
+
+std::vector<double> TerrainEngine::particle_weights(std::size_t max) const {
+  std::vector<double> out;
+  const std::size_t n = impl_->count;
+  if (max == 0 || !impl_->initialized) return out;
+  double total = 0.0;
+  for (float wi : impl_->w) total += wi;
+  const double inv = total > 0.0 ? 1.0 / total : 0.0;
+  const std::size_t take = std::min(max, n);
+  out.reserve(take);
+  for (std::size_t k = 0; k < take; ++k) out.push_back(impl_->w[k * n / take] * inv);
   return out;
 }
 
