@@ -248,19 +248,24 @@ TEST(TerrainEngine, StartOnAVoidIsDegradedDeadReckoning) {
   EXPECT_THAT(est.reason, ::testing::HasSubstr("void"));
 }
 
+/// Steps only (no barometer): count steps of length_m along heading_rad, one every period_ms.
+void feed_steps(TerrainEngine& pf, int count, int period_ms, double length_m, double heading_rad) {
+  for (int k = 1; k <= count; ++k) {
+    PdrStep s;
+    s.t_ns = k * period_ms * kNsPerMs;
+    s.length_m = length_m;
+    s.heading_rad = heading_rad;
+    pf.feed(s);
+  }
+}
+
 TEST(TerrainEngine, PropagationFollowsEquations1To4) {
   // No barometer: pure propagation. Heading 0 (north), 1 m steps, 200 steps at 0.5 s.
   TerrainOptions o = TerrainOptions::paper();
   o.particles = 20000;
   TerrainEngine pf(o, hills_dem(), 9);
   pf.initialize(hills_dem()->to_geodetic(0, 0), 5.0, 0);
-  for (int k = 1; k <= 200; ++k) {
-    PdrStep s;
-    s.t_ns = k * 500 * kNsPerMs;
-    s.length_m = 1.0;
-    s.heading_rad = 0.0;
-    pf.feed(s);
-  }
+  feed_steps(pf, 200, 500, 1.0, 0.0);
   const Estimate est = pf.estimate();
   EXPECT_EQ(est.status, EstimateStatus::kOk);
   // Mean: north ~ 200 * E[cos(b)]; with b ~ FOGM(15 deg) E[cos b] ~ exp(-sigma^2/2) = 0.966.
@@ -333,13 +338,7 @@ TEST(TerrainEngine, EstimateMomentsMatchADoubleReferenceFarFromTheOrigin) {
   o.particles = 5003;
   TerrainEngine pf(o, hills_dem(), 5);
   pf.initialize(hills_dem()->to_geodetic(4000.0, -4100.0), 3.0, 0);
-  for (int k = 1; k <= 20; ++k) {
-    PdrStep s;
-    s.t_ns = k * 550 * kNsPerMs;
-    s.length_m = 0.7;
-    s.heading_rad = 0.4;
-    pf.feed(s);
-  }
+  feed_steps(pf, 20, 550, 0.7, 0.4);
   const std::vector<Eigen::Vector2d> pts = pf.particles_en(o.particles);
   ASSERT_EQ(pts.size(), 5003u);
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();

@@ -132,6 +132,18 @@ inline float round_nearest(float x) {
   return (x + kMagic) - kMagic;
 }
 
+/// 2^f on [-0.5, 0.5]: degree-6 polynomial (coefficients ln2^n / n!, minimax-adjusted), for
+/// float and for the 4-lane Float4 (the same operations in the same order).
+template <typename T>
+inline T exp2_poly(T f) {
+  T p = f * 1.5403530e-4f + 1.3333558e-3f;
+  p = p * f + 9.6181291e-3f;
+  p = p * f + 5.5504109e-2f;
+  p = p * f + 2.4022651e-1f;
+  p = p * f + 6.9314718e-1f;
+  return p * f + 1.0f;
+}
+
 /// exp(x) for x <= 0 (relative error < 2e-7 for x > -87; 0 below). Cody-Waite split into
 /// 2^k * 2^f with a degree-6 polynomial for 2^f on [-0.5, 0.5].
 inline float fast_exp_neg(float x) {
@@ -140,14 +152,7 @@ inline float fast_exp_neg(float x) {
   const float t = xc * 1.44269504f;  // x / ln 2
   const float k = round_nearest(t);
   const float f = t - k;  // [-0.5, 0.5]
-  // 2^f Taylor/minimax coefficients (ln2^n / n!)
-  float p = 1.5403530e-4f;
-  p = p * f + 1.3333558e-3f;
-  p = p * f + 9.6181291e-3f;
-  p = p * f + 5.5504109e-2f;
-  p = p * f + 2.4022651e-1f;
-  p = p * f + 6.9314718e-1f;
-  p = p * f + 1.0f;
+  const float p = exp2_poly(f);
   const std::int32_t bits = (static_cast<std::int32_t>(k) + 127) << 23;
   float scale;
   std::memcpy(&scale, &bits, sizeof scale);
@@ -179,13 +184,7 @@ inline Float4 fast_exp_neg4(Float4 x) {
   const Float4 t = xc * 1.44269504f;
   const Float4 k = (t + 12582912.0f) - 12582912.0f;  // round_nearest
   const Float4 f = t - k;
-  Float4 p = splat4(1.5403530e-4f);
-  p = p * f + 1.3333558e-3f;
-  p = p * f + 9.6181291e-3f;
-  p = p * f + 5.5504109e-2f;
-  p = p * f + 2.4022651e-1f;
-  p = p * f + 6.9314718e-1f;
-  p = p * f + 1.0f;
+  const Float4 p = exp2_poly(f);
   const Int4 bits = (__builtin_convertvector(k, Int4) + 127) << 23;
   return select4(in_range, p * reinterpret_cast<Float4>(bits), splat4(0.0f));
 }
