@@ -63,10 +63,11 @@ TEST(FastMath, FourLaneExpEqualsScalarExp) {
   xs.push_back(-0.0f);
   while (xs.size() % 4 != 0) xs.push_back(0.0f);
   for (std::size_t i = 0; i < xs.size(); i += 4) {
-    const Float4 y = fast_exp_neg4(load4(xs.data() + i));
+    float y[4];
+    store4(y, fast_exp_neg4(load4(xs.data() + i)));
     for (std::size_t l = 0; l < 4; ++l) {
       const float ref = fast_exp_neg(xs[i + l]);
-      ASSERT_EQ(std::memcmp(&ref, &y[static_cast<int>(l)], sizeof ref), 0) << "x = " << xs[i + l];
+      ASSERT_EQ(std::memcmp(&ref, &y[l], sizeof ref), 0) << "x = " << xs[i + l];
     }
   }
   const Float4 sel = select4(Int4{-1, 0, -1, 0}, splat4(1.0f), splat4(2.0f));
