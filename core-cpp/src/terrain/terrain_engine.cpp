@@ -1,12 +1,14 @@
 // SIR particle filter of Broyles et al., Sensors 2018, 18, 2232 (Eq. 1-10), structure of arrays.
-// One fused pass per step: propagate (Eq. 1-4), look up the DEM, weight (Eq. 5-7) and
-// accumulate the sums for Neff (Eq. 10) and the residual monitor. Weights are kept
+// A step runs over blocks of 256 particles: propagate (Eq. 1-4) and find the DEM cell
+// (vectorised), gather the cell's nodes (scalar), weight (Eq. 5-7), update the bias means and
+// accumulate the sums for Neff (Eq. 10) and the residual monitor (vectorised). Weights are kept
 // unnormalised with their sum; resampling copies into a second buffer and swaps.
 #include "pdnav/terrain/terrain_engine.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <iomanip>
@@ -75,6 +77,247 @@ void fogm(double sigma, double tau_s, double dt_s, float& phi, float& q) {
   q = static_cast<float>(sigma * std::sqrt(std::max(0.0, 1.0 - p * p)));
 }
 
+/// Particles per block of the step kernels: the block's scratch (4 random words, a cell index,
+/// 3 floats) is 8 KiB, inside L1 with the particle slices it works on.
+constexpr std::size_t kBlock = 256;
+using LaneRng = detail::LaneXoshiro128Plus<kBlock>;
+
+struct BlockScratch {
+  alignas(64) std::uint32_t r0[kBlock], r1[kBlock], r2[kBlock], r3[kBlock];  // random words
+  alignas(64) std::int32_t idx[kBlock];  // south-west node of the particle's cell (0 when off)
+  alignas(64) float tx[kBlock], ty[kBlock];  // position inside the cell, 0..1
+  alignas(64) float off[kBlock];  // 0 on the tile, NaN off it (added to the elevation)
+  alignas(64) float h[kBlock];    // bilinear DEM elevation (NaN = void / off the tile)
+};
+
+/// Per-step constants of the propagation (Eq. 1-4).
+struct PropagateCoeffs {
+  float len, dl_span, s_th, c_th, phi_h, q_h, phi_b, q_b, phi_s, q_s;
+};
+
+/// Per-update constants of the weighting (Eq. 5-7) and the Rao-Blackwellised bias update.
+struct WeighCoeffs {
+  float z, inv_2r, no_info_ll, renorm, gain_k;
+  float outlier_r2;  // the monitor's bound: (outlier sigmas)^2 x innovation variance
+  bool segment, track_h0;
+};
+
+/// Pass 1: Eq. 1-4 for m particles from the block's random words. One straight loop without calls or stores that depend on data: GCC
+/// vectorises it (-fopt-info-vec; docs/terrain.md "Speed").
+void propagate_block(const PropagateCoeffs& k, std::size_t m, float* __restrict e,
+                     float* __restrict n, float* __restrict bh, float* __restrict bb, float* __restrict sc,
+                     BlockScratch& __restrict s) {
+  for (std::size_t j = 0; j < m; ++j) {
+    float sb, cb;
+    detail::fast_sincos(bh[j], sb, cb);
+    const std::uint32_t r3 = s.r3[j];
+    // Step-length noise dl ~ U(-sigma_l, sigma_l) (Eq. 1-2) from the top 16 bits of word 3.
+    const float dl = (static_cast<float>(static_cast<std::int32_t>(r3 >> 16)) * (1.0f / 65536.0f) - 0.5f) * k.dl_span;
+    const float step_len = k.len * (1.0f + sc[j]) + dl;
+    e[j] += step_len * (k.s_th * cb + k.c_th * sb);  // east = l sin(theta + b), Eq. 1
+    n[j] += step_len * (k.c_th * cb - k.s_th * sb);  // north = l cos(theta + b), Eq. 2
+    bh[j] = detail::wrap_pi_f(k.phi_h * bh[j] + k.q_h * detail::normal_from_words(s.r0[j], s.r1[j]));  // Eq. 3
+    // Eq. 4 with an Irwin-Hall(3) normal from word 2 and the low half of word 3.
+    const float nb =
+        (static_cast<float>(detail::halves_sum(s.r2[j]) + static_cast<std::int32_t>(r3 & 0xFFFFu)) * (1.0f / 65536.0f) -
+         1.5f) * 2.0f;
+    bb[j] = k.phi_b * bb[j] + k.q_b * nb;
+    sc[j] = k.phi_s * sc[j] + k.q_s * nb;  // slope-varying stride (q_s = 0 unless the bias is RB)
+  }
+}
+
+/// Pass 1b: the DEM cell of each new position (a second straight loop: GCC does not if-convert
+/// it inside pass 1).
+void locate_block(const Dem::Grid& g, std::size_t m, const float* __restrict e, const float* __restrict n,
+                  BlockScratch& __restrict s) {
+  for (std::size_t j = 0; j < m; ++j) {
+    const float fx = (e[j] - g.x0_m) * g.inv_cell;
+    const float fy = (n[j] - g.y0_m) * g.inv_cell;
+    // & not &&: no branches, so that the loop vectorises; false for NaN
+    const bool on = (fx >= 0.0f) & (fy >= 0.0f) & (fx < g.max_fx) & (fy < g.max_fy);
+    // Clamp into the grid without branches (NaN -> 0; maxss/minss): the conversions below then
+    // run unconditionally, which lets GCC if-convert the loop (a guarded float -> int
+    // conversion may trap and is never if-converted).
+    float cx = 0.0f < fx ? fx : 0.0f;
+    float cy = 0.0f < fy ? fy : 0.0f;
+    cx = cx < g.max_fx ? cx : g.last_fx;
+    cy = cy < g.max_fy ? cy : g.last_fy;
+    const auto ix = static_cast<std::int32_t>(cx);
+    const auto iy = static_cast<std::int32_t>(cy);
+    s.idx[j] = iy * g.cols + ix;
+    s.tx[j] = cx - static_cast<float>(ix);
+    s.ty[j] = cy - static_cast<float>(iy);
+    s.off[j] = on ? 0.0f : std::numeric_limits<float>::quiet_NaN();
+  }
+}
+
+/// Pass 2: bilinear elevation of each particle's cell (the scalar gather; voids are NaN nodes).
+void gather_block(const Dem::Grid& g, std::size_t m, BlockScratch& __restrict s) {
+  const float* v = g.values;
+  const std::size_t cols = static_cast<std::size_t>(g.cols);
+  for (std::size_t j = 0; j < m; ++j) {
+    const float* q = v + static_cast<std::size_t>(s.idx[j]);
+    const float tx = s.tx[j];
+    const float south = q[0] + tx * (q[1] - q[0]);
+    const float north = q[cols] + tx * (q[cols + 1] - q[cols]);
+    s.h[j] = south + s.ty[j] * (north - south) + s.off[j];
+  }
+}
+
+/// Accumulators of one update: weights, squared weights, weight on valid DEM, the weighted
+/// first two moments of the residual z - pred over valid particles, and the number of valid
+/// particles within the monitor's outlier bound.
+struct Sums {
+  double w = 0, w2 = 0, valid = 0, r = 0, r2 = 0, within = 0;
+};
+
+/// Pass 3: Eq. 5-7, the bias-mean update and the sums for Neff and the monitor, four particles
+/// at a time in explicit SIMD lanes (fast_math.h: GCC does not vectorise the reductions nor the
+/// selects around the exp polynomial by itself); float partials per block, added to the
+/// double totals once per block. The scalar tail does the same per particle.
+void weigh_block(const WeighCoeffs& c, std::size_t m, const float* __restrict hs, float* __restrict h0,
+                 float* __restrict bb, const float* __restrict an, float* __restrict w, Sums& total) {
+  using detail::Float4;
+  using detail::Int4;
+  using detail::load4;
+  using detail::select4;
+  using detail::splat4;
+  using detail::store4;
+  const Int4 segment = c.segment ? Int4{-1, -1, -1, -1} : Int4{};
+  const Float4 zero = splat4(0.0f), one = splat4(1.0f);
+  Float4 sw{}, sw2{}, sv{}, sr{}, sr2{}, sin{};
+  std::size_t i = 0;
+  for (; i + 4 <= m; i += 4) {
+    const Float4 h = load4(hs + i), before = load4(h0 + i);
+    // Segment mean (trapezoid of the elevation at the last update and now) when known.
+    const Float4 pred = select4(segment & (before == before), 0.5f * (before + h), h);
+    store4(h0 + i, c.track_h0 ? h : before);
+    const Float4 b = load4(bb + i);
+    const Float4 r = c.z - (pred + b + load4(an + i));
+    const Float4 wi = load4(w + i) * c.renorm;
+    const Float4 r2 = r * r;
+    const Int4 valid = r2 == r2;  // false for voids / off the tile (NaN)
+    const Float4 ll = select4(valid, -r2 * c.inv_2r, splat4(c.no_info_ll));  // Gaussian likelihood, Eq. 5-7
+    Float4 wn = wi * detail::fast_exp_neg4(ll);
+    wn = select4(wn < 1e-30f, zero, wn);  // keep clear of denormals
+    store4(w + i, wn);
+    const Float4 r_ok = select4(valid, r, zero);
+    const Float4 wv = select4(valid, wi, zero);
+    store4(bb + i, b + c.gain_k * r_ok);  // Rao-Blackwellised bias mean (gain 0 otherwise)
+    sw += wn;
+    sw2 += wn * wn;
+    sv += wv;
+    sr += wv * r_ok;
+    sr2 += wv * r_ok * r_ok;
+    sin += select4(valid & (r2 <= c.outlier_r2), one, zero);
+  }
+  for (; i < m; ++i) {  // tail: lane 0
+    const float h = hs[i], before = h0[i];
+    const float pred = c.segment && before == before ? 0.5f * (before + h) : h;
+    h0[i] = c.track_h0 ? h : before;
+    const float r = c.z - (pred + bb[i] + an[i]);
+    const float wi = w[i] * c.renorm;
+    const float r2 = r * r;
+    const bool valid = r2 == r2;
+    float wn = wi * detail::fast_exp_neg(valid ? -r2 * c.inv_2r : c.no_info_ll);
+    wn = wn < 1e-30f ? 0.0f : wn;
+    w[i] = wn;
+    const float r_ok = valid ? r : 0.0f;
+    const float wv = valid ? wi : 0.0f;
+    bb[i] += c.gain_k * r_ok;
+    sw[0] += wn;
+    sw2[0] += wn * wn;
+    sv[0] += wv;
+    sr[0] += wv * r_ok;
+    sr2[0] += wv * r_ok * r_ok;
+    sin[0] += valid && r2 <= c.outlier_r2 ? 1.0f : 0.0f;
+  }
+  const auto lane_sum = [](Float4 v) {
+    return static_cast<double>(v[0]) + static_cast<double>(v[1]) + static_cast<double>(v[2]) + static_cast<double>(v[3]);
+  };
+  total.w += lane_sum(sw);
+  total.w2 += lane_sum(sw2);
+  total.valid += lane_sum(sv);
+  total.r += lane_sum(sr);
+  total.r2 += lane_sum(sr2);
+  total.within += lane_sum(sin);
+}
+
+/// Weighted mean (Eq. 8) and covariance (Eq. 9) of a cloud: two passes (mean, then centred
+/// second moments) in 4-lane float partials added to double totals every kBlock particles;
+/// positions relative to the first particle, so float keeps millimetres on any tile.
+struct CloudMoments {
+  double sw = 0, me = 0, mn = 0, cee = 0, cnn = 0, cen = 0;
+};
+
+CloudMoments cloud_moments(const float* e, const float* n, const float* w, std::size_t count) {
+  using detail::Float4;
+  using detail::load4;
+  CloudMoments c;
+  if (count == 0) return c;
+  const auto lane_sum = [](Float4 v) {
+    return static_cast<double>(v[0]) + static_cast<double>(v[1]) + static_cast<double>(v[2]) + static_cast<double>(v[3]);
+  };
+  const float e0 = e[0], n0 = n[0];
+  double se = 0, sn = 0;
+  std::size_t i = 0;
+  while (i + 4 <= count) {
+    Float4 aw{}, ae{}, an{};
+    for (const std::size_t end = std::min(count, i + kBlock); i + 4 <= end; i += 4) {
+      const Float4 wi = load4(w + i);
+      aw += wi;
+      ae += wi * (load4(e + i) - e0);
+      an += wi * (load4(n + i) - n0);
+    }
+    c.sw += lane_sum(aw);
+    se += lane_sum(ae);
+    sn += lane_sum(an);
+  }
+  for (; i < count; ++i) {
+    c.sw += w[i];
+    se += static_cast<double>(w[i]) * (e[i] - e0);
+    sn += static_cast<double>(w[i]) * (n[i] - n0);
+  }
+  if (!(c.sw > 0.0)) c.sw = 1.0;
+  const double de_mean = se / c.sw, dn_mean = sn / c.sw;
+  c.me = e0 + de_mean;
+  c.mn = n0 + dn_mean;
+  const auto fe = static_cast<float>(de_mean) + e0, fn = static_cast<float>(dn_mean) + n0;
+  // Centre on the float mean; the residual offset (< 1 ulp of the position) is corrected below.
+  double see = 0, snn = 0, sen = 0, sde = 0, sdn = 0;
+  i = 0;
+  while (i + 4 <= count) {
+    Float4 aee{}, ann{}, aen{}, ae{}, an{};
+    for (const std::size_t end = std::min(count, i + kBlock); i + 4 <= end; i += 4) {
+      const Float4 wi = load4(w + i), de = load4(e + i) - fe, dn = load4(n + i) - fn;
+      const Float4 wde = wi * de, wdn = wi * dn;
+      aee += wde * de;
+      ann += wdn * dn;
+      aen += wde * dn;
+      ae += wde;
+      an += wdn;
+    }
+    see += lane_sum(aee);
+    snn += lane_sum(ann);
+    sen += lane_sum(aen);
+    sde += lane_sum(ae);
+    sdn += lane_sum(an);
+  }
+  for (; i < count; ++i) {
+    const double wi = w[i], de = e[i] - fe, dn = n[i] - fn;
+    see += wi * de * de;
+    snn += wi * dn * dn;
+    sen += wi * de * dn;
+    sde += wi * de;
+    sdn += wi * dn;
+  }
+  const double mde = sde / c.sw, mdn = sdn / c.sw;  // mean offset from the centre used
+  c.cee = std::max(0.0, see / c.sw - mde * mde);
+  c.cnn = std::max(0.0, snn / c.sw - mdn * mdn);
+  c.cen = sen / c.sw - mde * mdn;
+  return c;
+}
+
 }  // namespace
 
 const char* to_string(Resampling r) {
@@ -135,7 +378,8 @@ struct TerrainEngine::Impl {
   std::vector<float> w;         // unnormalised weights, sum in w_sum
   double w_sum = 0.0;
   std::vector<double> cdf;      // resampling scratch
-  std::vector<float> resid;     // z - prediction per particle (NaN: void / off the tile)
+  LaneRng lanes;                // propagation noise: kBlock vectorised streams
+  std::unique_ptr<BlockScratch> scratch = std::make_unique<BlockScratch>();
 
   bool initialized = false;
   TimeNs t_ns = 0;              // time of the last step (or initialisation)
@@ -161,7 +405,7 @@ struct TerrainEngine::Impl {
   mutable std::vector<TerrainMode> cache_modes;
 
   Impl(const TerrainOptions& o, std::shared_ptr<const Dem> d, std::uint64_t seed)
-      : opt(o), dem(std::move(d)), rng(seed) {
+      : opt(o), dem(std::move(d)), rng(seed), lanes(seed ^ 0x6A09E667F3BCC909ULL) {
     if (!dem) throw std::invalid_argument("TerrainEngine: no DEM");
     if (opt.particles < 1 || opt.particles > 50'000'000)
       throw std::invalid_argument("TerrainEngine: particles must be 1..5e7");
@@ -174,7 +418,6 @@ struct TerrainEngine::Impl {
     w.assign(count, 1.0f);
     w_sum = static_cast<double>(count);
     cdf.assign(count, 0.0);
-    resid.assign(count, 0.0f);
     nis_window.assign(static_cast<std::size_t>(std::max(1, opt.monitor_window)), 0.0);
   }
 
@@ -442,129 +685,55 @@ struct TerrainEngine::Impl {
       phi_s = static_cast<float>(ph);
       q_s = static_cast<float>(opt.stride_grade_sigma * std::sqrt(std::max(0.0, 1.0 - ph * ph)));
     }
-    const auto dl_span = static_cast<float>(2.0 * opt.step_length_sigma_m * gain);
-    const auto s_th = static_cast<float>(std::sin(step.heading_rad));
-    const auto c_th = static_cast<float>(std::cos(step.heading_rad));
+    PropagateCoeffs k;
+    k.dl_span = static_cast<float>(2.0 * opt.step_length_sigma_m * gain);
+    k.s_th = static_cast<float>(std::sin(step.heading_rad));
+    k.c_th = static_cast<float>(std::cos(step.heading_rad));
+    k.len = len;
+    k.phi_h = phi_h;
+    k.q_h = q_h;
+    k.phi_b = phi_b;
+    k.q_b = q_b;
+    k.phi_s = phi_s;
+    k.q_s = q_s;
     const bool measure = std::isfinite(z);
-    const auto zf = static_cast<float>(z);
+    WeighCoeffs wc;
+    wc.z = static_cast<float>(z);
     const double innov_var = innovation_var();  // Eq. 5-7 (+ P)
-    const auto inv_2r = static_cast<float>(0.5 / innov_var);
-    const auto no_info_ll = static_cast<float>(-0.5 * opt.no_info_sigmas * opt.no_info_sigmas);
-    const auto renorm = static_cast<float>(static_cast<double>(count) / w_sum);  // keeps mean weight ~1
-    const Dem& d = *dem;
-    float* pe = p.e.data();
-    float* pn = p.n.data();
-    float* pbh = p.bh.data();
-    float* pbb = p.bb.data();
-    float* psc = p.sc.data();
-    float* ph0 = p.h0.data();
-    const float* pan = p.an.data();
-    const bool segment = opt.segment_mean_elevation && !h0_stale;
-    const bool track_h0 = opt.segment_mean_elevation;
+    wc.inv_2r = static_cast<float>(0.5 / innov_var);
+    wc.no_info_ll = static_cast<float>(-0.5 * opt.no_info_sigmas * opt.no_info_sigmas);
+    wc.renorm = static_cast<float>(static_cast<double>(count) / w_sum);  // keeps mean weight ~1
+    wc.outlier_r2 = static_cast<float>(opt.monitor_outlier_sigmas * opt.monitor_outlier_sigmas * innov_var);
+    // Rao-Blackwellised bias: the Kalman gain is common to all particles, so each mean is
+    // updated with its own residual in the weighting pass (voids / off the tile: no update).
+    const double gain_k = rb ? bias_var_m2 / innov_var : 0.0;
+    wc.gain_k = static_cast<float>(gain_k);
+    wc.segment = opt.segment_mean_elevation && !h0_stale;
+    wc.track_h0 = opt.segment_mean_elevation;
     if (measure) h0_stale = false;
-    float* pr = resid.data();
-    for (std::size_t i = 0; i < count; ++i) {
-      const std::uint64_t r1 = rng.next();
-      const std::uint64_t r2 = rng.next();
-      float sb, cb;
-      fast_sincos(pbh[i], sb, cb);
-      const float dl = (static_cast<float>(r2 >> 48) * (1.0f / 65536.0f) - 0.5f) * dl_span;
-      const float step_len = len * (1.0f + psc[i]) + dl;
-      pe[i] += step_len * (s_th * cb + c_th * sb);  // east = l sin(theta + b), Eq. 1
-      pn[i] += step_len * (c_th * cb - s_th * sb);  // north = l cos(theta + b), Eq. 2
-      pbh[i] = detail::wrap_pi_f(phi_h * pbh[i] + q_h * normal_from_bits(r1));  // Eq. 3
-      // Eq. 4 with an Irwin-Hall(3) normal from the low 48 bits of r2.
-      const float nb = (static_cast<float>((r2 & 0xFFFFu) + ((r2 >> 16) & 0xFFFFu) + ((r2 >> 32) & 0xFFFFu)) *
-                            (1.0f / 65536.0f) - 1.5f) * 2.0f;
-      pbb[i] = phi_b * pbb[i] + q_b * nb;
-      psc[i] = phi_s * psc[i] + q_s * nb;  // slope-varying stride (q_s = 0 unless the bias is RB)
-      if (measure) {
-        const float h = d.elevation_or_nan(pe[i], pn[i]);  // NaN = void / off the tile
-        float pred = h;
-        if (segment) pred = ph0[i] == ph0[i] ? 0.5f * (ph0[i] + h) : h;  // segment mean (trapezoid)
-        if (track_h0) ph0[i] = h;
-        pr[i] = zf - (pred + pbb[i] + pan[i]);
-      }
+    const Dem::Grid grid = dem->grid();
+    Sums total;
+    BlockScratch& b = *scratch;
+    // Blocks of kBlock particles: the scratch (random words, cell indices, elevations) stays in
+    // L1; pass 1 and 3 are plain float loops that GCC vectorises, pass 2 is the scalar gather.
+    for (std::size_t base = 0; base < count; base += kBlock) {
+      const std::size_t m = std::min(kBlock, count - base);
+      lanes.fill4(b.r0, b.r1, b.r2, b.r3);
+      propagate_block(k, m, p.e.data() + base, p.n.data() + base, p.bh.data() + base, p.bb.data() + base,
+                      p.sc.data() + base, b);
+      if (!measure) continue;
+      locate_block(grid, m, p.e.data() + base, p.n.data() + base, b);
+      gather_block(grid, m, b);
+      weigh_block(wc, m, b.h, p.h0.data() + base, p.bb.data() + base, p.an.data() + base, w.data() + base,
+                  total);
     }
     if (!measure) return;
-    weight_pass(renorm, inv_2r, no_info_ll);
-    if (rb) update_bias_means(innov_var);
+    if (rb) bias_var_m2 *= 1.0 - gain_k;  // before a recovery in the monitor widens it again
+    finish_update(total, innov_var);
   }
 
-  /// Rao-Blackwellised baro bias: Kalman measurement update of each particle's bias mean with
-  /// its own residual (voids / off the tile: no update) and of the common variance.
-  void update_bias_means(double innov_var) {
-    const double k = bias_var_m2 / innov_var;
-    const auto kf = static_cast<float>(k);
-    float* pbb = p.bb.data();
-    const float* pr = resid.data();
-    for (std::size_t i = 0; i < count; ++i) {
-      const float r = pr[i];
-      pbb[i] += r == r ? kf * r : 0.0f;
-    }
-    bias_var_m2 *= 1.0 - k;
-  }
-
-  /// Eq. 5-7 over the residuals of the propagation pass, in lanes of 8 so that the compiler can
-  /// vectorise the likelihood, the weights and the sums for Neff and the monitor.
-  void weight_pass(float renorm, float inv_2r, float no_info_ll) {
-    constexpr std::size_t kLanes = 8;
-    float* pw = w.data();
-    const float* pr = resid.data();
-    Sums total;
-    float lw[kLanes] = {}, lw2[kLanes] = {}, lv[kLanes] = {}, lr[kLanes] = {}, lr2[kLanes] = {};
-    float lmin[kLanes];
-    std::fill(lmin, lmin + kLanes, std::numeric_limits<float>::infinity());
-    auto one = [&](std::size_t i, std::size_t l) {
-      const float wi = pw[i] * renorm;
-      const float r = pr[i];
-      const float r2f = r * r;
-      const bool valid = r2f == r2f;  // false for voids / off the tile (NaN)
-      const float ll = valid ? -r2f * inv_2r : no_info_ll;  // Gaussian likelihood, Eq. 5-7
-      float wn = wi * fast_exp_neg(ll);
-      wn = wn < 1e-30f ? 0.0f : wn;  // keep clear of denormals
-      pw[i] = wn;
-      const float wv = valid ? wi : 0.0f;
-      const float rv = valid ? r : 0.0f;
-      lmin[l] = valid && r2f < lmin[l] ? r2f : lmin[l];
-      lw[l] += wn;
-      lw2[l] += wn * wn;
-      lv[l] += wv;
-      lr[l] += wv * rv;
-      lr2[l] += wv * rv * rv;
-    };
-    std::size_t i = 0;
-    for (; i + kLanes <= count; i += kLanes) {
-      for (std::size_t l = 0; l < kLanes; ++l) one(i + l, l);
-      if ((i & 1023u) == 1016u) flush_lanes(total, lw, lw2, lv, lr, lr2);  // float partials -> double
-    }
-    for (std::size_t l = 0; i < count; ++i, ++l) one(i, l);
-    flush_lanes(total, lw, lw2, lv, lr, lr2);
-    float min_r2 = lmin[0];
-    for (float m : lmin) min_r2 = std::min(min_r2, m);
-    finish_update(total, min_r2);
-  }
-
-
-  /// Accumulators of one update: weights, squared weights, weight on valid DEM, and the
-  /// weighted first two moments of the residual z - pred over valid particles.
-  struct Sums {
-    double w = 0, w2 = 0, valid = 0, r = 0, r2 = 0;
-  };
-
-  template <std::size_t N>
-  static void flush_lanes(Sums& t, float (&lw)[N], float (&lw2)[N], float (&lv)[N], float (&lr)[N], float (&lr2)[N]) {
-    for (std::size_t l = 0; l < N; ++l) {
-      t.w += lw[l];
-      t.w2 += lw2[l];
-      t.valid += lv[l];
-      t.r += lr[l];
-      t.r2 += lr2[l];
-      lw[l] = lw2[l] = lv[l] = lr[l] = lr2[l] = 0.0f;
-    }
-  }
-
-  void finish_update(const Sums& sums, float min_r2) {
+  /// Totals of the update; innov_var is the innovation variance the weights used.
+  void finish_update(const Sums& sums, double innov_var) {
     double s_w = sums.w, s_w2 = sums.w2;
     const double s_valid = sums.valid;
     const double prior_total = static_cast<double>(count);  // weights were renormalised to mean 1
@@ -583,15 +752,15 @@ struct TerrainEngine::Impl {
     }
     w_sum = s_w;
     sum_sq = s_w2;
-    monitor(s_valid, sums.r, sums.r2, min_r2);
+    monitor(s_valid, sums.r, sums.r2, sums.within, innov_var);
   }
 
   /// Residual monitoring: window mean of the normalised innovation squared of the baro
-  /// measurement against the particle prediction; alarms re-spread the cloud.
-  void monitor(double s_valid, double s_r, double s_r2, float min_r2) {
+  /// measurement against the particle prediction (r_var: the update's innovation variance);
+  /// alarms re-spread the cloud.
+  void monitor(double s_valid, double s_r, double s_r2, double within, double r_var) {
     const double mean_r = s_r / s_valid;  // z - mean prediction
     const double var = std::max(0.0, s_r2 / s_valid - mean_r * mean_r);
-    const double r_var = innovation_var();
     const double nis = mean_r * mean_r / (var + r_var);
     stats.last_nis = nis;
     nis_window[nis_next] = nis;
@@ -602,7 +771,7 @@ struct TerrainEngine::Impl {
     stats.mean_nis = mean;
     if (!opt.residual_monitor) return;
     const double out = opt.monitor_outlier_sigmas;
-    const bool outlier = static_cast<double>(min_r2) > out * out * r_var;
+    const bool outlier = !(within > 0.0);  // no valid particle within out sigmas (weigh_block)
     const bool drift = nis_filled == nis_window.size() && mean > opt.monitor_nis_threshold;
     if (!outlier && !drift) return;
     std::ostringstream os;
@@ -738,7 +907,8 @@ struct TerrainEngine::Impl {
   /// smoothed twice with [1 2 1]/4, cut at valleys deeper than mode_valley_fraction of the
   /// smaller neighbouring peak; groups lighter than mode_min_weight join their neighbour
   /// across the shallower cut, groups closer than mode_min_separation_m merge.
-  /// Empty: one mode, the estimate itself (a cloud narrower than mode_min_separation_m / 4).
+  /// Empty: one mode, the estimate itself (a cloud narrower than mode_min_separation_m / 4, or
+  /// a histogram without a valley: then the per-bin moments are never computed).
   std::vector<Moments> find_modes(const Eigen::Vector2d& mean, const Eigen::Matrix2d& cov) const {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
     const double major_sd = std::sqrt(std::max(0.0, eig.eigenvalues()(1)));
@@ -748,19 +918,22 @@ struct TerrainEngine::Impl {
     // +-4 sigma along the major axis (one pass; particles beyond go to the end bins).
     const double lo = -4.0 * major_sd, hi = 4.0 * major_sd;
     const double scale = kBins / (hi - lo) * (1.0 - 1e-9);
+    // Bin of a particle, in float (a bin is 1/6 sigma wide); NaN and far-out particles land
+    // in the end bins.
+    const auto me = static_cast<float>(mean.x()), mn = static_cast<float>(mean.y());
+    const auto ux = static_cast<float>(u.x() * scale), uy = static_cast<float>(u.y() * scale);
+    const auto f0 = static_cast<float>(-lo * scale);
+    const auto bin_of = [&](std::size_t i) {
+      const float f = (p.e[i] - me) * ux + (p.n[i] - mn) * uy + f0;
+      return f > 0.0f ? (f < kBins - 1.0f ? static_cast<int>(f) : kBins - 1) : 0;
+    };
+    // Pass 1: the weight histogram alone. The per-bin moments (pass 2) are needed only when
+    // the histogram has a valley, i.e. when the cloud may be multimodal.
     std::array<double, kBins> h{};
-    std::array<Moments, kBins> bin{};
-    Moments all;
-    for (std::size_t i = 0; i < count; ++i) {
-      if (!(w[i] > 0.0f)) continue;
-      const double x = (p.e[i] - mean.x()) * u.x() + (p.n[i] - mean.y()) * u.y();
-      const double f = (x - lo) * scale;  // NaN and far-out particles land in the end bins
-      const int b = f > 0.0 ? (f < kBins - 1.0 ? static_cast<int>(f) : kBins - 1) : 0;
-      h[b] += w[i];
-      bin[b].add(w[i], p.e[i], p.n[i]);
-    }
-    for (const Moments& m : bin) all.add(m);
-    if (!(all.w > 0)) return {};
+    for (std::size_t i = 0; i < count; ++i) h[static_cast<std::size_t>(bin_of(i))] += w[i];
+    double all_w = 0.0;
+    for (double v : h) all_w += v;
+    if (!(all_w > 0)) return {};
     for (int pass = 0; pass < 2; ++pass) {
       std::array<double, kBins> g{};
       for (int b = 0; b < kBins; ++b)
@@ -782,13 +955,17 @@ struct TerrainEngine::Impl {
         peak = valley = b;
       }
     }
+    if (cuts.empty()) return {};  // one group: the estimate itself
+    std::array<Moments, kBins> bin{};
+    for (std::size_t i = 0; i < count; ++i)
+      if (w[i] > 0.0f) bin[static_cast<std::size_t>(bin_of(i))].add(w[i], p.e[i], p.n[i]);
     std::vector<Moments> groups;
     std::vector<double> cut_depth;  // between groups[k] and groups[k + 1]
     int start = 0;
     for (std::size_t c = 0; c <= cuts.size(); ++c) {
       const int end = c < cuts.size() ? cuts[c] : kBins;
       Moments m;
-      for (int b = start; b < end; ++b) m.add(bin[b]);
+      for (int b = start; b < end; ++b) m.add(bin[static_cast<std::size_t>(b)]);
       groups.push_back(m);
       if (c < cuts.size()) cut_depth.push_back(depth[c]);
       start = end;
@@ -801,7 +978,7 @@ struct TerrainEngine::Impl {
     for (bool changed = true; changed && groups.size() > 1;) {
       changed = false;
       for (std::size_t k = 0; k < groups.size() && groups.size() > 1; ++k) {
-        if (groups[k].w >= opt.mode_min_weight * all.w) continue;
+        if (groups[k].w >= opt.mode_min_weight * all_w) continue;
         if (k == 0) merge(0);
         else if (k + 1 == groups.size()) merge(k - 1);
         else merge(cut_depth[k - 1] > cut_depth[k] ? k - 1 : k);  // across the shallower cut
@@ -827,25 +1004,10 @@ struct TerrainEngine::Impl {
       est.reason = start_err.empty() ? "terrain: no start position" : start_err;
       return est;
     }
-    double sw = 0.0, me = 0.0, mn = 0.0;
-    for (std::size_t i = 0; i < count; ++i) {
-      const double wi = w[i];
-      sw += wi;
-      me += wi * p.e[i];
-      mn += wi * p.n[i];
-    }
-    if (!(sw > 0.0)) sw = 1.0;
-    me /= sw;
-    mn /= sw;
-    double cee = 0.0, cnn = 0.0, cen = 0.0;
-    for (std::size_t i = 0; i < count; ++i) {  // Eq. 9
-      const double de = p.e[i] - me, dn = p.n[i] - mn, wi = w[i];
-      cee += wi * de * de;
-      cnn += wi * dn * dn;
-      cen += wi * de * dn;
-    }
+    const CloudMoments cm = cloud_moments(p.e.data(), p.n.data(), w.data(), count);
+    const double sw = cm.sw, me = cm.me, mn = cm.mn;
     est.en_m = Eigen::Vector2d(me, mn);  // Eq. 8
-    est.cov_en_m2 << cee / sw, cen / sw, cen / sw, cnn / sw;
+    est.cov_en_m2 << cm.cee, cm.cen, cm.cen, cm.cnn;  // Eq. 9
     est.position = dem->to_geodetic(me, mn);
     const DemSample ground = dem->at_local(me, mn);
     est.position.h_m = ground.valid() ? ground.elevation_m : 0.0;  // DEM datum (docs/terrain.md)
@@ -963,6 +1125,19 @@ std::vector<Eigen::Vector2d> TerrainEngine::particles_en(std::size_t max) const 
   return out;
 }
 
+std::vector<double> TerrainEngine::particle_weights(std::size_t max) const {
+  std::vector<double> out;
+  const std::size_t n = impl_->count;
+  if (max == 0 || !impl_->initialized) return out;
+  double total = 0.0;
+  for (float wi : impl_->w) total += wi;
+  const double inv = total > 0.0 ? 1.0 / total : 0.0;
+  const std::size_t take = std::min(max, n);
+  out.reserve(take);
+  for (std::size_t k = 0; k < take; ++k) out.push_back(impl_->w[k * n / take] * inv);
+  return out;
+}
+
 Eigen::Vector2d TerrainEngine::bias_estimate() const {
   double sw = 0.0, sh = 0.0, sb = 0.0;
   for (std::size_t i = 0; i < impl_->count; ++i) {
@@ -976,8 +1151,8 @@ Eigen::Vector2d TerrainEngine::bias_estimate() const {
 
 std::size_t TerrainEngine::bytes_per_particle() {
   // 7 floats (5 states + segment-start elevation + start-anchor offset) x 2 buffers + 1 float
-  // weight + 1 float residual + 1 double resampling scratch
-  return 2 * 7 * sizeof(float) + 2 * sizeof(float) + sizeof(double);
+  // weight + 1 double resampling scratch (the step's residuals live in a per-block scratch)
+  return 2 * 7 * sizeof(float) + sizeof(float) + sizeof(double);
 }
 
 }  // namespace pdnav::terrain

@@ -3,6 +3,7 @@
 // metres in the local ENU tangent plane of a geodetic origin (pdnav::geo::LocalFrame at
 // (origin_lat, origin_lon, 0)), with bilinear interpolation and a validity flag.
 #pragma once
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <stdexcept>
@@ -75,6 +76,20 @@ class Dem {
     const float south = p[0] + tx * (p[1] - p[0]);
     const float north = p[cols_] + tx * (p[cols_ + 1] - p[cols_]);
     return south + ty * (north - south);
+  }
+
+  /// Hot-path view of the grid for lookups in blocks (the particle filter): node values
+  /// row-major, south -> north, and the float transform elevation_or_nan uses. A node index
+  /// fits int32 (the format caps a tile at 2^28 nodes). Valid while the Dem lives.
+  struct Grid {
+    const float* values;
+    std::int32_t cols;
+    float x0_m, y0_m, inv_cell, max_fx, max_fy;
+    float last_fx, last_fy;  // the largest float below max_fx / max_fy: inside the last cell
+  };
+  Grid grid() const {
+    return {values_.data(), static_cast<std::int32_t>(cols_), x0_f_, y0_f_, inv_cell_f_, max_fx_, max_fy_,
+            std::nextafter(max_fx_, 0.0f), std::nextafter(max_fy_, 0.0f)};
   }
 
   /// The tile's ENU frame (origin at origin_lat/lon, h = 0).

@@ -196,6 +196,9 @@ class TerrainEngine {
   std::vector<TerrainMode> modes() const;
   /// Up to max particles (evenly thinned), east/north in the DEM frame.
   std::vector<Eigen::Vector2d> particles_en(std::size_t max) const;
+  /// The weights of the same particles as particles_en(max), normalised by the whole cloud's
+  /// total weight (sum to 1 when max >= the particle count).
+  std::vector<double> particle_weights(std::size_t max) const;
   /// Weighted means of the bias states (heading bias rad, baro bias m incl. the start anchor offset).
   Eigen::Vector2d bias_estimate() const;
   const TerrainStats& stats() const;
