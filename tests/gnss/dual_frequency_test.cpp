@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "pdnav/gnss/measurements.h"
+#include "pdnav/gnss/solver_smoothing.h"
 #include "pdnav/gnss/solver_synthetic.h"
 #include "pdnav/gnss/spp.h"
 
@@ -218,6 +219,34 @@ TEST(DualFrequency, BuildEpochPairsL5RowsOnlyInDualMode) {
   }
   EXPECT_EQ(combined, 4);
   EXPECT_EQ(ex2.count("signal: not L1/E1/B1 (one band used)"), 0u);
+}
+
+TEST(DualFrequency, SmootherAveragesTheIfCorrectionAndRestartsOnASwitch) {
+  // no carrier smoothing (window 0) isolates the ionosphere average: the IF correction is
+  // -4 m +- 3 m (alternating noise); averaged over 300 s it converges to -4 m
+  SmoothingOptions o;
+  o.window_s = 0.0;
+  o.iono_window_s = 300.0;
+  CodeSmoother sm(o);
+  const SatId g{Constellation::kGps, 3};
+  double last = 0.0;
+  for (int k = 0; k < 400; ++k) {
+    sm.begin_epoch(k == 0 ? 0.0 : 1.0, 0.0);
+    const double l1 = 2.2e7 + 10.0 * k;
+    const double corr = -4.0 + (k % 2 == 0 ? 3.0 : -3.0);
+    SmoothingInput in{g, l1 + corr, kNaN, kNaN, true, l1};
+    last = sm.smooth_epoch({in})[0] - l1;
+  }
+  EXPECT_NEAR(last, -4.0, 0.05);  // raw IF: -7 or -1
+  // the same satellite as single frequency: the raw L1 code, no leftover correction
+  sm.begin_epoch(1.0, 0.0);
+  const double l1 = 2.3e7;
+  SmoothingInput single{g, l1, kNaN, kNaN, false, kNaN};
+  EXPECT_EQ(sm.smooth_epoch({single})[0], l1);
+  // back to IF: restarted (the raw correction, not the old average)
+  sm.begin_epoch(1.0, 0.0);
+  SmoothingInput again{g, l1 + 2.0, kNaN, kNaN, true, l1};
+  EXPECT_NEAR(sm.smooth_epoch({again})[0] - l1, 2.0, 1e-9);
 }
 
 }  // namespace
