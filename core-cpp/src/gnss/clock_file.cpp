@@ -8,6 +8,7 @@
 
 #include "pdnav/geo/time.h"
 #include "pdnav/gnss/rinex.h"
+#include "pdnav/gnss/sp3.h"
 
 namespace pdnav::gnss {
 namespace {
@@ -70,33 +71,20 @@ class ClockParser {
       if (has_label(l, "TIME SYSTEM ID")) {
         const auto ts = tokens(l.substr(0, 60));
         if (!ts.empty()) out_.time_system = ts[0];
-        const std::string& s = out_.time_system;
-        if (s != "GPS" && s != "GAL" && s != "QZS" && s != "UTC" && s != "TAI" && s != "BDT")
-          fail("unsupported TIME SYSTEM ID '" + s + "'");
+        if (!product_time_system_supported(out_.time_system))
+          fail("unsupported TIME SYSTEM ID '" + out_.time_system + "'");
       }
     }
     fail("no END OF HEADER");
   }
 
-  TimeNs to_gps_ns(double calendar_s) const {
-    const std::string& ts = out_.time_system;
-    double gps_s = calendar_s;
-    if (ts == "UTC") {
-      const auto unix_ms = static_cast<std::int64_t>(std::llround(calendar_s * 1e3)) + geo::kGpsEpochUnixMs;
-      gps_s += geo::leap_seconds_at_unix_ms(unix_ms);
-    } else if (ts == "TAI") {
-      gps_s -= 19.0;
-    } else if (ts == "BDT") {
-      gps_s += 14.0;
-    }
-    return static_cast<TimeNs>(std::llround(gps_s * 1e9));
-  }
+  TimeNs to_gps_ns(double calendar_s) const { return product_time_to_gps_ns(calendar_s, out_.time_system); }
 
   void skip(const std::string& why) { ++out_.skipped[why]; }
 
   void record(const std::string& l) {
-    if (l.find_first_not_of(" \t") == std::string::npos) return;  // blank line
     const auto t = tokens(l);
+    if (t.empty()) return;  // blank line (any white space, as the tokenizer sees it)
     const std::string& type = t[0];
     if (type != "AS" && type != "AR" && type != "CR" && type != "DR" && type != "MS") {
       skip("unknown record type");
