@@ -30,6 +30,7 @@ struct GnssArgs {
   std::string log;
   std::vector<std::string> nav;
   std::vector<std::string> sp3;
+  std::vector<std::string> clk;
   std::string truth;
   std::string truth_csv;
   std::string out;
@@ -38,7 +39,15 @@ struct GnssArgs {
   std::uint64_t seed = 1;
   int keep_every = 1;  // robustness check: keep every N-th epoch (duty cycling)
   bool clock_steps = false;  // robustness check: a 1 ms code-only clock step every epoch
+<<<<<<< HEAD
   bool hw_discontinuities = false;  // robustness check: HardwareClockDiscontinuityCount changes every epoch
+=======
+  double iono_window_s = gnss::SmoothingOptions{}.iono_window_s;
+  int dual_min_sats = gnss::MeasurementOptions{}.dual_min_sats;
+  double dual_min_fraction = gnss::MeasurementOptions{}.dual_min_fraction;
+  bool dual_keep_single = gnss::MeasurementOptions{}.dual_keep_single;
+  std::string freq = gnss::MeasurementOptions{}.frequency == gnss::FrequencyMode::kDual ? "dual" : "single";
+>>>>>>> wt/gnssb
   double kf_displacement_q_m2 = gnss::KalmanOptions{}.displacement_q_m2;
   double kf_fix_scale = gnss::KalmanOptions{}.fix_variance_scale;
   std::string dynamics = gnss::kf_dynamics_name(gnss::KalmanOptions{}.dynamics);
@@ -241,8 +250,22 @@ void run_gnss(const GnssArgs& a) {
     std::printf("sp3 %s: %zu epochs, %d satellites with precise orbits and clocks, %d lines skipped\n", f.c_str(),
                 sp3.epochs.size(), n, sp3.skipped_lines);
   }
+  if (!a.clk.empty() && a.sp3.empty()) throw std::runtime_error("--clk needs --sp3 (the clock file has no orbits)");
+  for (const std::string& f : a.clk) {
+    const gnss::ClockFile clk = gnss::read_rinex_clock_file(f);
+    const int n = store->add_precise_clocks(clk);
+    std::printf("clk %s: version %.2f, %s time, %lld satellite clock records, %d satellites, %lld records skipped\n",
+                f.c_str(), clk.version, clk.time_system.c_str(), static_cast<long long>(clk.records), n,
+                static_cast<long long>(clk.skipped_total()));
+    for (const auto& [why, k] : clk.skipped) std::printf("  skipped %lld: %s\n", static_cast<long long>(k), why.c_str());
+  }
   gnss::GnssOptions options;
   options.smoothing.window_s = a.smoothing_window_s;
+  options.smoothing.iono_window_s = a.iono_window_s;
+  options.measurements.dual_min_sats = a.dual_min_sats;
+  options.measurements.dual_min_fraction = a.dual_min_fraction;
+  options.measurements.dual_keep_single = a.dual_keep_single;
+  options.measurements.frequency = a.freq == "dual" ? gnss::FrequencyMode::kDual : gnss::FrequencyMode::kSingle;
   options.kalman.displacement_q_m2 = a.kf_displacement_q_m2;
   options.kalman.fix_variance_scale = a.kf_fix_scale;
   gnss::parse_kf_dynamics(a.dynamics, options.kalman.dynamics);  // validated by CLI11
@@ -294,6 +317,9 @@ void register_gnss(CLI::App& app) {
   cmd->add_option("--nav", args->nav, "RINEX navigation files (2 or 3)")->check(CLI::ExistingFile);
   cmd->add_option("--sp3", args->sp3, "precise orbits and clocks (SP3-c/d); used instead of broadcast where they cover")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--clk", args->clk,
+                  "precise satellite clocks (RINEX clock 3.0x, AS records) replacing the SP3 clocks; needs --sp3")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--truth", args->truth, "static truth LAT,LON,H (deg, deg, m ellipsoidal)");
   cmd->add_option("--truth-csv", args->truth_csv,
                   "per-epoch truth track, GSDC columns millisSinceGpsEpoch,latDeg,lngDeg,heightAboveWgs84EllipsoidM")
@@ -318,6 +344,20 @@ void register_gnss(CLI::App& app) {
   cmd->add_option("--spp-igg3", args->spp_igg3, "SPP IGG-III robust weights after the FDE (true/false)");
   cmd->add_option("--keep-every", args->keep_every, "robustness check: keep every N-th epoch (duty cycling)")
       ->check(CLI::Range(1, 3600));
+  cmd->add_option("--freq", args->freq,
+                  "single: L1/E1/B1 + Klobuchar; dual: L1/L5 (E1/E5a) ionosphere-free code per clock group "
+                  "where enough satellites track both bands (docs/gnss.md)")
+      ->check(CLI::IsMember({"single", "dual"}));
+  cmd->add_option("--iono-window", args->iono_window_s,
+                  "dual: averaging window of the IF ionosphere correction, s (0 = raw IF code)")
+      ->check(CLI::Range(0.0, 1e5));
+  cmd->add_option("--dual-min-sats", args->dual_min_sats, "dual: fewest L1+L5 satellites for a clock group to use IF")
+      ->check(CLI::Range(2, 64));
+  cmd->add_option("--dual-min-fraction", args->dual_min_fraction,
+                  "dual: smallest share of a clock group's satellites tracking L5 for IF")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_flag("--dual-keep-single", args->dual_keep_single,
+                "dual: keep the L1 code of L1-only satellites in an IF clock group (mixed; bias not modelled)");
   cmd->add_flag("--clock-steps", args->clock_steps,
                 "robustness check: step FullBiasNanos by 1 ms on every other epoch (code moves, carrier does not)");
   cmd->add_option("--seed", args->seed, "engine seed (the engine is deterministic)");

@@ -110,6 +110,16 @@ int EphemerisStore::add_precise(const Sp3File& sp3) {
   return n;
 }
 
+int EphemerisStore::add_precise_clocks(const ClockFile& clk) {
+  int n = 0;
+  for (const auto& [sat, v] : clk.sats) {
+    if (v.empty()) continue;
+    precise_clock_[sat] = v;
+    ++n;
+  }
+  return n;
+}
+
 std::optional<SatState> EphemerisStore::precise_state(const SatId& sat, TimeNs t, std::string* why_not) const {
   const auto it = precise_.find(sat);
   if (it == precise_.end()) return refuse(why_not, "no precise orbit");
@@ -144,11 +154,19 @@ std::optional<SatState> EphemerisStore::precise_state(const SatId& sat, TimeNs t
   SatState s;
   s.pos = geo::Ecef(interp(0.0));
   s.vel_mps = interp(0.5) - interp(-0.5);
-  const double c0 = tr.clock_s[static_cast<std::size_t>(k - 1)], c1 = tr.clock_s[static_cast<std::size_t>(k)];
-  if (!std::isfinite(c0) || !std::isfinite(c1)) return refuse(why_not, "no precise clock");
-  const double f = ns_to_s(t - tr.t[static_cast<std::size_t>(k - 1)]) / step_s;
-  s.clock_drift_sps = (c1 - c0) / step_s;
-  s.clock_bias_s = c0 + f * (c1 - c0) - 2.0 * s.pos.p_m.dot(s.vel_mps) / (kSpeedOfLight_mps * kSpeedOfLight_mps);
+  double clock_s = 0.0;
+  if (const auto ck = precise_clock_.find(sat); ck != precise_clock_.end()) {  // RINEX clock file
+    std::string why;
+    if (!interpolate_clock(ck->second, t, options_.precise_clock, clock_s, s.clock_drift_sps, &why))
+      return refuse(why_not, why.c_str());
+  } else {
+    const double c0 = tr.clock_s[static_cast<std::size_t>(k - 1)], c1 = tr.clock_s[static_cast<std::size_t>(k)];
+    if (!std::isfinite(c0) || !std::isfinite(c1)) return refuse(why_not, "no precise clock");
+    const double f = ns_to_s(t - tr.t[static_cast<std::size_t>(k - 1)]) / step_s;
+    s.clock_drift_sps = (c1 - c0) / step_s;
+    clock_s = c0 + f * (c1 - c0);
+  }
+  s.clock_bias_s = clock_s - 2.0 * s.pos.p_m.dot(s.vel_mps) / (kSpeedOfLight_mps * kSpeedOfLight_mps);
   s.toe_gps_ns = tr.t[static_cast<std::size_t>(k - 1)];
   s.iode = -1;  // precise
   std::string ignore;

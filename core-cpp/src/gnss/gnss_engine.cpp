@@ -112,8 +112,9 @@ struct GnssEngine::Impl {
       SatState st;
       if (!sat_state(m, ep.rx, st)) continue;
       if (m.code_ok()) {
-        sm_in.push_back(SmoothingInput{m.sat, m.pseudorange_m, m.adr_ok() ? m.adr_m : kNaN, m.pr_rate_mps});
-        spp_obs.push_back(SppObservation{m.sat, m.pseudorange_m, m.cn0_dbhz, carrier_hz(m, st), st});
+        sm_in.push_back(SmoothingInput{m.sat, m.pseudorange_m, m.adr_ok() ? m.adr_m : kNaN, m.pr_rate_mps, m.iono_free,
+                                       m.pseudorange_l1_m});
+        spp_obs.push_back(SppObservation{m.sat, m.pseudorange_m, m.cn0_dbhz, carrier_hz(m, st), st, m.iono_free, m.var_scale});
       }
       CarrierObservation c;
       c.sat = m.sat;

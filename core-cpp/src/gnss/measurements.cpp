@@ -168,7 +168,73 @@ bool supported(Constellation c) {
          c == Constellation::kBeidou || c == Constellation::kQzss;
 }
 
+/// Receiver-clock group (QZSS is steered to GPS time and shares its clock, as in spp.h).
+Constellation dual_group(Constellation sys) { return sys == Constellation::kQzss ? Constellation::kGps : sys; }
+
+double median_of(std::vector<double> v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  if (v.size() % 2 == 1) return *mid;
+  return 0.5 * (*mid + *std::max_element(v.begin(), mid));
+}
+
 }  // namespace
+
+bool l5_band(Constellation sys, double carrier_hz) {
+  if (!std::isfinite(carrier_hz)) return false;
+  if (sys != Constellation::kGps && sys != Constellation::kQzss && sys != Constellation::kGalileo &&
+      sys != Constellation::kBeidou)
+    return false;
+  return std::fabs(carrier_hz - 1176.45e6) < 1e6;
+}
+
+void combine_dual_frequency(std::vector<Measurement>& meas, const MeasurementOptions& opt, ExclusionCounts& excluded) {
+  std::map<Constellation, std::vector<std::size_t>> code_sats, dual_sats;
+  for (std::size_t i = 0; i < meas.size(); ++i) {
+    const Measurement& m = meas[i];
+    if (!m.code_ok()) continue;
+    const Constellation g = dual_group(m.sat.sys);
+    code_sats[g].push_back(i);
+    if (std::isfinite(m.pseudorange_l5_m) && std::isfinite(m.cn0_l5_dbhz)) dual_sats[g].push_back(i);
+  }
+  auto noise_var = [&](double cn0) { return opt.dual_var_a_m2 + opt.dual_var_b_m2 * std::pow(10.0, -cn0 / 10.0); };
+  for (const auto& [g, all] : code_sats) {
+    const auto it = dual_sats.find(g);
+    const std::size_t n_dual = it == dual_sats.end() ? 0 : it->second.size();
+    if (n_dual == 0) continue;
+    if (static_cast<int>(n_dual) < std::max(2, opt.dual_min_sats) ||
+        static_cast<double>(n_dual) < opt.dual_min_fraction * static_cast<double>(all.size())) {
+      excluded["dual: too few dual-frequency satellites in the clock group (single frequency)"] +=
+          static_cast<std::int64_t>(n_dual);
+      continue;
+    }
+    std::vector<double> d;
+    for (std::size_t i : it->second) d.push_back(meas[i].pseudorange_m - meas[i].pseudorange_l5_m);
+    const double med = median_of(d);
+    std::vector<bool> combined(meas.size(), false);
+    for (std::size_t k = 0; k < it->second.size(); ++k) {
+      Measurement& m = meas[it->second[k]];
+      const double dev = d[k] - med;
+      if (!(std::fabs(dev) <= opt.dual_max_deviation_m)) {
+        ++excluded["dual: L1-L5 difference far from the group median (code dropped)"];
+        m.pseudorange_m = kNaN;
+        continue;
+      }
+      m.pseudorange_l1_m = m.pseudorange_m;
+      m.pseudorange_m += kIfBeta * dev;
+      m.iono_free = true;
+      m.var_scale = kIfAlpha * kIfAlpha + kIfBeta * kIfBeta * noise_var(m.cn0_l5_dbhz) / noise_var(m.cn0_dbhz);
+      combined[it->second[k]] = true;
+      ++excluded["dual: ionosphere-free code used"];
+    }
+    for (std::size_t i : all) {
+      if (combined[i] || !meas[i].code_ok()) continue;
+      if (opt.dual_keep_single) { ++excluded["dual: L1-only satellite kept in an IF group"]; continue; }
+      ++excluded["dual: L1-only satellite of an IF group (code not used)"];
+      meas[i].pseudorange_m = kNaN;
+    }
+  }
+}
 
 double default_carrier_hz(Constellation sys, int glonass_channel) {
   switch (sys) {
@@ -227,6 +293,8 @@ bool build_epoch(const std::vector<GnssRawSample>& rows, const MeasurementOption
     out.clock_drift_mps = c.drift_nanos_per_second * 1e-9 * kSpeedOfLight_mps;
   out.leap_seconds = (c.leap_second != kMissingInt && c.leap_second >= 0 && c.leap_second < 100)
                          ? static_cast<int>(c.leap_second) : geo::leap_seconds_at_gps_ns(out.rx.ns);
+  const bool dual = opt.frequency == FrequencyMode::kDual;
+  std::vector<Measurement> l5;  // second-band codes (dual mode)
   for (const GnssRawSample& r : rows) {
     Measurement m;
     m.sat = SatId::from_android(r.constellation_type, r.svid);
@@ -237,17 +305,35 @@ bool build_epoch(const std::vector<GnssRawSample>& rows, const MeasurementOption
     if (m.sat.sys == Constellation::kGlonass && r.svid >= 93 && r.svid <= 106) m.glonass_channel = r.svid - 100;
     if (finite_and_small(r.carrier_frequency_hz, 1e10) && r.carrier_frequency_hz > 1e8) m.carrier_hz = r.carrier_frequency_hz;
     if (r.code_type.size() <= 4) m.code_type = r.code_type;
-    if (!l1_band(m.sat.sys, m.carrier_hz)) { ++excluded["signal: not L1/E1/B1 (one band used)"]; continue; }
+    const bool second = dual && l5_band(m.sat.sys, m.carrier_hz);
+    if (!second && !l1_band(m.sat.sys, m.carrier_hz)) {
+      ++excluded[dual ? "signal: neither L1/E1/B1 nor L5/E5a" : "signal: not L1/E1/B1 (one band used)"];
+      continue;
+    }
     // TimeOffsetNanos is per measurement, so each row has its own receive time
     GpsTime rx;
     if (!receive_gps_time(r, rx)) { ++excluded["epoch: no GPS time (FullBiasNanos missing)"]; continue; }
     fill_code(r, rx, out.leap_seconds, opt, m, excluded);
+    if (second) {  // only the code of the second band is used (ADR/Doppler stay L1)
+      if (m.code_ok()) l5.push_back(m);
+      continue;
+    }
     fill_rate(r, opt, m, excluded);
     fill_adr(r, opt, m, excluded);
     if (!m.code_ok() && !std::isfinite(m.pr_rate_mps) && !std::isfinite(m.adr_m)) continue;
     out.meas.push_back(m);
   }
   drop_duplicates(out.meas, excluded);
+  if (dual) {
+    drop_duplicates(l5, excluded);
+    for (const Measurement& s5 : l5) {
+      auto it = std::find_if(out.meas.begin(), out.meas.end(), [&](const Measurement& o) { return o.sat == s5.sat; });
+      if (it == out.meas.end() || !it->code_ok()) { ++excluded["dual: L5/E5a code without L1 code (not used)"]; continue; }
+      it->pseudorange_l5_m = s5.pseudorange_m;
+      it->cn0_l5_dbhz = s5.cn0_dbhz;
+    }
+    combine_dual_frequency(out.meas, opt, excluded);
+  }
   return !out.meas.empty();
 }
 

@@ -17,7 +17,7 @@ double CodeSmoother::innovation(const SmoothingInput& in) const {
   const auto it = sats_.find(in.sat);
   if (it == sats_.end()) return std::nan("");
   const Sat& s = it->second;
-  if (!(s.epoch == epoch_ - 1 && dt_s_ > 0.0 && opt_.window_s > 0.0)) return std::nan("");
+  if (!(s.epoch == epoch_ - 1 && dt_s_ > 0.0 && opt_.window_s > 0.0 && s.iono_free == in.iono_free)) return std::nan("");
   double delta = std::nan("");
   if (std::isfinite(in.adr_m) && std::isfinite(s.adr_m)) delta = in.adr_m - s.adr_m - clock_jump_m_;
   else if (std::isfinite(in.pr_rate_mps) && std::isfinite(s.pr_rate_mps))
@@ -25,7 +25,31 @@ double CodeSmoother::innovation(const SmoothingInput& in) const {
   return in.pseudorange_m - (s.pr_sm_m + delta);
 }
 
-std::vector<double> CodeSmoother::smooth_epoch(const std::vector<SmoothingInput>& in, std::vector<std::string>* reasons) {
+SmoothingInput CodeSmoother::with_iono_average(const SmoothingInput& in) {
+  if (!in.iono_free || !std::isfinite(in.pseudorange_m) || !std::isfinite(in.pseudorange_l1_m) ||
+      !(opt_.iono_window_s > 0.0))
+    return in;
+  Sat& s = sats_[in.sat];
+  const double corr = in.pseudorange_m - in.pseudorange_l1_m;
+  const bool continuous = s.epoch == epoch_ - 1 && dt_s_ > 0.0 && s.iono_free && s.iono_n > 0.0 &&
+                          std::fabs(corr - s.iono_corr_m) <= opt_.iono_max_jump_m;
+  if (continuous) {
+    s.iono_n = std::min(s.iono_n + 1.0, std::max(1.0, opt_.iono_window_s / dt_s_));
+    s.iono_corr_m += (corr - s.iono_corr_m) / s.iono_n;
+  } else {
+    s.iono_n = 1.0;
+    s.iono_corr_m = corr;
+  }
+  SmoothingInput out = in;
+  out.pseudorange_m = in.pseudorange_l1_m + s.iono_corr_m;
+  return out;
+}
+
+std::vector<double> CodeSmoother::smooth_epoch(const std::vector<SmoothingInput>& in_raw, std::vector<std::string>* reasons) {
+  // the averaged ionosphere correction first (it does not depend on the carrier)
+  std::vector<SmoothingInput> in;
+  in.reserve(in_raw.size());
+  for (const auto& x : in_raw) in.push_back(with_iono_average(x));
   common_step_m_ = 0.0;
   if (opt_.remove_common_step) {
     std::vector<double> d;
@@ -51,7 +75,9 @@ std::vector<double> CodeSmoother::smooth_epoch(const std::vector<SmoothingInput>
 double CodeSmoother::smooth(const SmoothingInput& in, std::string* reason) {
   if (!std::isfinite(in.pseudorange_m)) return in.pseudorange_m;
   Sat& s = sats_[in.sat];
-  const bool continuous = s.epoch == epoch_ - 1 && dt_s_ > 0.0 && opt_.window_s > 0.0;
+  const bool continuous = s.epoch == epoch_ - 1 && dt_s_ > 0.0 && opt_.window_s > 0.0 && s.iono_free == in.iono_free;
+  if (s.epoch == epoch_ - 1 && s.iono_free != in.iono_free && reason != nullptr)
+    *reason = "smoothing: single/dual frequency switch (restarted)";
   double delta = std::nan("");
   if (continuous && std::isfinite(in.adr_m) && std::isfinite(s.adr_m)) {
     delta = in.adr_m - s.adr_m - clock_jump_m_;
@@ -73,6 +99,7 @@ double CodeSmoother::smooth(const SmoothingInput& in, std::string* reason) {
   s.adr_m = in.adr_m;
   s.pr_rate_mps = in.pr_rate_mps;
   s.epoch = epoch_;
+  s.iono_free = in.iono_free;
   return s.pr_sm_m;
 }
 

@@ -62,7 +62,7 @@ class Sp3Parser {
 
   void offset_check() const {
     const std::string& ts = out_.time_system;
-    if (ts != "GPS" && ts != "GAL" && ts != "UTC" && ts != "TAI" && ts != "BDT")
+    if (!product_time_system_supported(ts) || ts == "QZS")
       fail("unsupported SP3 time system '" + ts + "'");
   }
 
@@ -72,19 +72,7 @@ class Sp3Parser {
     return *v;
   }
 
-  TimeNs to_gps_ns(double calendar_s) const {
-    const std::string& ts = out_.time_system;
-    double gps_s = calendar_s;
-    if (ts == "UTC") {
-      const auto unix_ms = static_cast<std::int64_t>(std::llround(calendar_s * 1e3)) + geo::kGpsEpochUnixMs;
-      gps_s += geo::leap_seconds_at_unix_ms(unix_ms);
-    } else if (ts == "TAI") {
-      gps_s -= 19.0;
-    } else if (ts == "BDT") {
-      gps_s += 14.0;
-    }
-    return static_cast<TimeNs>(std::llround(gps_s * 1e9));
-  }
+  TimeNs to_gps_ns(double calendar_s) const { return product_time_to_gps_ns(calendar_s, out_.time_system); }
 
   int integer(const std::string& f) const {
     const double v = number(f);
@@ -140,6 +128,23 @@ class Sp3Parser {
 };
 
 }  // namespace
+
+bool product_time_system_supported(const std::string& ts) {
+  return ts == "GPS" || ts == "GAL" || ts == "QZS" || ts == "UTC" || ts == "TAI" || ts == "BDT";
+}
+
+TimeNs product_time_to_gps_ns(double calendar_s, const std::string& ts) {
+  double gps_s = calendar_s;
+  if (ts == "UTC") {
+    const auto unix_ms = static_cast<std::int64_t>(std::llround(calendar_s * 1e3)) + geo::kGpsEpochUnixMs;
+    gps_s += geo::leap_seconds_at_unix_ms(unix_ms);
+  } else if (ts == "TAI") {
+    gps_s -= 19.0;
+  } else if (ts == "BDT") {
+    gps_s += 14.0;
+  }
+  return static_cast<TimeNs>(std::llround(gps_s * 1e9));
+}
 
 Sp3File read_sp3(std::istream& in, const std::string& name) { return Sp3Parser(in, name).run(); }
 

@@ -91,15 +91,15 @@ Row model_row(const SppObservation& o, const Eigen::VectorXd& x, const Layout& l
     r.el_rad = ae.el_rad;
     r.masked = ae.el_rad < deg_to_rad(opt.elevation_mask_deg);
     const geo::Geodetic g = geo::to_geodetic(rx_ecef);
-    if (opt.ionosphere && klob != nullptr && ae.el_rad > 0.0) {
+    if (opt.ionosphere && klob != nullptr && ae.el_rad > 0.0 && !o.iono_free) {
       const double scale = std::pow(kL1Hz / o.carrier_hz, 2);
       atmo_m += scale * kSpeedOfLight_mps * klobuchar_delay_s(*klob, g, ae.az_rad, ae.el_rad, tow_s);
     }
     if (opt.troposphere && ae.el_rad > 0.0) atmo_m += saastamoinen_delay_m(g, ae.el_rad);
   }
-  const double sat_clock_m = kSpeedOfLight_mps * (o.state.clock_bias_s - signal_group_delay_s(o));
+  const double sat_clock_m = kSpeedOfLight_mps * (o.state.clock_bias_s - (o.iono_free ? 0.0 : signal_group_delay_s(o)));
   r.residual_m = o.pseudorange_m - (range + clock - sat_clock_m + atmo_m);
-  r.var_m2 = cn0_elevation_variance(opt.code_var_a_m2, opt.code_var_b_m2, o.cn0_dbhz, r.el_rad);
+  r.var_m2 = o.var_scale * cn0_elevation_variance(opt.code_var_a_m2, opt.code_var_b_m2, o.cn0_dbhz, r.el_rad);
   return r;
 }
 

@@ -23,6 +23,7 @@
 #include "pdnav/geo/samples.h"
 #include "pdnav/geo/units.h"
 #include "pdnav/gnss/atmosphere.h"
+#include "pdnav/gnss/clock_file.h"
 #include "pdnav/gnss/sp3.h"
 #include "pdnav/gnss/types.h"
 
@@ -109,6 +110,7 @@ struct EphemerisStoreOptions {
   // inside the SP3 span with a full stencil; otherwise the broadcast ephemeris.
   int precise_points = 10;
   bool prefer_precise = true;
+  ClockInterpolationOptions precise_clock;  // RINEX clock files (add_precise_clocks): linear, <= 330 s
 };
 
 class EphemerisStore {
@@ -134,6 +136,14 @@ class EphemerisStore {
   /// to the ionosphere-free combination). Returns the number of satellites added.
   int add_precise(const Sp3File& sp3);
   bool has_precise() const { return !precise_.empty(); }
+  /// Precise satellite clocks from a RINEX clock file (AS records, e.g. 30 s): for every
+  /// satellite the file has, precise states take the clock from it (linear interpolation,
+  /// options().precise_clock) instead of the SP3 clock column; same conventions as the SP3
+  /// clock (relativistic term added here, group delay as above). Outside the file's span or
+  /// across a gap that satellite has no precise state ("gap in the precise clock": the
+  /// broadcast ephemeris is used). Needs add_precise for the orbits. Returns the number of
+  /// satellites with clocks.
+  int add_precise_clocks(const ClockFile& clk);
 
   /// One GnssLogger `Nav` row of GPS L1 C/A (type 0x0101): `svid` (PRN), `subframe_id`
   /// (Sub-messageId, 1..5) and the 40 data bytes (10 words of 30 bits, each in 32 bits,
@@ -180,6 +190,7 @@ class EphemerisStore {
     std::vector<double> clock_s;           // NaN when the epoch has no clock
   };
   std::map<SatId, PreciseTrack> precise_;
+  std::map<SatId, std::vector<ClockSample>> precise_clock_;
   std::optional<SatState> precise_state(const SatId& sat, TimeNs t, std::string* why_not) const;
   std::optional<SatState> broadcast_state(const SatId& sat, TimeNs t, std::string* why_not) const;
 };

@@ -66,6 +66,15 @@ struct Measurement {
   double carrier_hz = kNaN;             // CarrierFrequencyHz, or NaN (use default_carrier_hz)
   std::string code_type;                // GnssMeasurement CodeType ("C", "Q", "X", ...), "" unknown
   int glonass_channel = 99;             // FDMA channel from an Android svid 93..106, 99 = unknown
+  // Dual frequency (MeasurementOptions::frequency = kDual): when the satellite's clock group
+  // uses the ionosphere-free combination this epoch, pseudorange_m is the L1/L5 (E1/E5a)
+  // ionosphere-free code referenced to the L1 receiver clock (see combine_dual_frequency);
+  // ADR, Doppler, C/N0, carrier_hz and code_type stay those of the L1 signal.
+  bool iono_free = false;
+  double var_scale = 1.0;               // code variance factor vs the L1 model (IF: alpha^2 + beta^2 v5/v1)
+  double pseudorange_l1_m = kNaN;       // the L1 code before the combination (NaN when not combined)
+  double pseudorange_l5_m = kNaN;       // the L5/E5a code of the same satellite, NaN when not tracked
+  double cn0_l5_dbhz = kNaN;
   bool code_ok() const { return pseudorange_m == pseudorange_m; }
   bool adr_ok() const { return adr_m == adr_m && !adr_reset && !adr_cycle_slip; }
 };
@@ -83,7 +92,31 @@ struct MeasurementEpoch {
   std::vector<Measurement> meas;
 };
 
+/// Which bands the code solution uses.
+///   kSingle: L1/E1/B1 only, Klobuchar for the ionosphere; L5/E5a rows counted and dropped.
+///   kDual:   per clock group (GPS+QZSS, Galileo, ...) and epoch, the L1/L5 ionosphere-free
+///            code when enough of the group's satellites track both bands (otherwise the whole
+///            group stays single frequency + Klobuchar: see combine_dual_frequency).
+enum class FrequencyMode { kSingle, kDual };
+
 struct MeasurementOptions {
+  FrequencyMode frequency = FrequencyMode::kSingle;  // default chosen by measurement (docs/gnss.md)
+  // Dual frequency: a clock group is combined when at least dual_min_sats of its code
+  // satellites, and at least dual_min_fraction of them, track L5/E5a. The receiver's L1-L5
+  // bias (2.35 km GPS / 1.91 km Galileo on the GSDC Pixel 5) differs per group; mixing IF and
+  // L1 codes in one clock group would need its own bias unknown, so the group is all-or-none.
+  int dual_min_sats = 4;
+  double dual_min_fraction = 0.75;
+  /// Satellites of a combined group whose L1-L5 difference is this far from the group median
+  /// are dropped (an L5 multipath/tracking error): 20 m = 25 m of L1 ionosphere difference.
+  double dual_max_deviation_m = 20.0;
+  /// Keep the L1 code of a combined group's L1-only satellites (mixes IF and L1 in one clock
+  /// group: the few-metre mean-ionosphere mismatch is not modelled). Default false: dropped.
+  bool dual_keep_single = false;
+  // code noise model used for the IF variance factor (same form and values as SppOptions:
+  // sigma^2 = a + b 10^(-C/N0/10), Walker 2019 Sec. 2.3), evaluated per band's C/N0
+  double dual_var_a_m2 = 4.0;
+  double dual_var_b_m2 = 160000.0;
   double min_cn0_dbhz = 15.0;            // issue 7 / Walker 2019 Sec. 2.2: reject C/N0 < 15 dB-Hz
   double max_uncertainty = 1e6;         // uncertainties above this (e.g. 3.4e38 "unknown") reject the field
   double max_pr_sigma_m = 150.0;        // ReceivedSvTimeUncertainty * c above this: code unusable
@@ -100,6 +133,29 @@ using ExclusionCounts = std::map<std::string, std::int64_t>;
 /// false (epoch unusable, counted) when the clock fields are missing or invalid.
 bool build_epoch(const std::vector<GnssRawSample>& rows, const MeasurementOptions& opt,
                  MeasurementEpoch& out, ExclusionCounts& excluded);
+
+/// True for an L5-band signal usable as the second frequency (GPS/QZSS L5, Galileo E5a,
+/// BeiDou B2a: 1176.45 MHz).
+bool l5_band(Constellation sys, double carrier_hz);
+
+/// Ionosphere-free combination coefficients for L1 (f1) and L5 (f5):
+///   IF = alpha P1 - beta P5, alpha = f1^2/(f1^2-f5^2) = 2.2606, beta = f5^2/(f1^2-f5^2) = 1.2606
+/// (Misra & Enge 2011 Sec. 5.3.2). The code noise is amplified by sqrt(alpha^2 + beta^2) = 2.59
+/// for equal noise on both bands.
+inline constexpr double kIfAlpha = 1575.42e6 * 1575.42e6 / (1575.42e6 * 1575.42e6 - 1176.45e6 * 1176.45e6);
+inline constexpr double kIfBeta = kIfAlpha - 1.0;
+
+/// Dual-frequency step of build_epoch (public for the tests). `meas` are the L1 measurements
+/// with pseudorange_l5_m / cn0_l5_dbhz filled where the satellite tracks L5/E5a. Per clock group
+/// (QZSS with GPS): when the group qualifies (dual_min_sats, dual_min_fraction), every
+/// dual satellite's code becomes
+///   P_IF = P1 + beta (d - median_group(d)),  d = P1 - P5,
+/// i.e. the IF code minus beta x the epoch's median L1-L5 difference. The median carries the
+/// receiver L1-L5 bias (and the satellites' mean group delay), so P_IF stays on the L1 receiver
+/// clock up to the group's median ionosphere (absorbed by the group's clock/ISB like the bias),
+/// and the satellite's own ionosphere and TGD/BGD are removed. var_scale = alpha^2 + beta^2 v5/v1.
+/// L1-only satellites of a combined group lose their code (counted) unless dual_keep_single.
+void combine_dual_frequency(std::vector<Measurement>& meas, const MeasurementOptions& opt, ExclusionCounts& excluded);
 
 /// Receive time in GPS time: TimeNanos + TimeOffsetNanos - (FullBiasNanos + BiasNanos).
 /// false when FullBiasNanos is missing (the receiver has no GPS time yet).

@@ -21,6 +21,11 @@ struct SmoothingOptions {
   /// clock discontinuity) is common to all satellites; a slip or multipath is not.
   bool remove_common_step = true;
   int min_sats_common_step = 4;     // fewer continuous satellites: no common-step estimate
+  /// Averaging window of the dual-frequency ionosphere correction (s); 0 = the raw IF code.
+  /// The L1 ionosphere changes by < 0.1 m per minute outside storms (Klobuchar's diurnal cosine
+  /// at 10-50 m peak-to-peak vertical L1 delay over ~12 h), measured effect in docs/gnss.md.
+  double iono_window_s = 300.0;
+  double iono_max_jump_m = 10.0;    // a larger change of the IF correction restarts its average
 };
 
 /// One satellite's inputs at an epoch (NaN when missing).
@@ -29,6 +34,15 @@ struct SmoothingInput {
   double pseudorange_m = 0.0;
   double adr_m = 0.0;               // NaN unless valid and not reset / slipped
   double pr_rate_mps = 0.0;
+  /// The code is the ionosphere-free combination (smoothed with the L1 carrier: the code-carrier
+  /// divergence is 1 x the L1 ionosphere rate instead of 2 x); a change of this flag between
+  /// epochs restarts the satellite (the code moves by its ionosphere).
+  bool iono_free = false;
+  /// With iono_free: the L1 code the IF code was formed from. The IF correction
+  /// (pseudorange_m - pseudorange_l1_m, i.e. minus the satellite's relative L1 ionosphere) is
+  /// averaged over iono_window_s before it is added to the L1 code: the ionosphere changes
+  /// slowly, so this removes most of the 2.6x noise amplification of the IF combination.
+  double pseudorange_l1_m = 0.0;
 };
 
 class CodeSmoother {
@@ -54,6 +68,8 @@ class CodeSmoother {
     double pr_sm_m = 0.0, adr_m = 0.0, pr_rate_mps = 0.0;
     double n = 0.0;
     std::int64_t epoch = -1;
+    bool iono_free = false;
+    double iono_corr_m = 0.0, iono_n = 0.0;  // averaged IF correction and its sample count
   };
   SmoothingOptions opt_;
   std::map<SatId, Sat> sats_;
@@ -63,6 +79,8 @@ class CodeSmoother {
   double common_step_m_ = 0.0;
   /// code - propagated for a continuous satellite, NaN otherwise
   double innovation(const SmoothingInput& in) const;
+  /// The input with its IF correction replaced by the running average (iono_window_s).
+  SmoothingInput with_iono_average(const SmoothingInput& in);
 };
 
 }  // namespace pdnav::gnss

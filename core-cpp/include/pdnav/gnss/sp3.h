@@ -32,6 +32,12 @@ struct Sp3File {
   int skipped_lines = 0;      // malformed / bad-value satellite lines
 };
 
+/// Time systems of precise products (SP3, RINEX clock): GPS, GAL, QZS (steered to GPS time, taken
+/// as GPS time), UTC (+ leap seconds), TAI (- 19 s), BDT (+ 14 s).
+bool product_time_system_supported(const std::string& time_system);
+/// Calendar seconds since the GPS epoch read in `time_system` -> GPS time, ns.
+TimeNs product_time_to_gps_ns(double calendar_s, const std::string& time_system);
+
 /// Throws std::runtime_error("name:line: reason") on a bad header or unsupported time system.
 Sp3File read_sp3(std::istream& in, const std::string& name);
 Sp3File read_sp3_file(const std::string& path);

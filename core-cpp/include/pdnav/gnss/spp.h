@@ -63,6 +63,10 @@ struct SppObservation {
   double cn0_dbhz = 0.0;
   double carrier_hz = 1575.42e6;
   SatState state;  // at transmit time, from EphemerisStore::state
+  /// The code is the L1/L5 ionosphere-free combination (measurements.h): no Klobuchar and no
+  /// TGD/BGD (the combination removes both); its variance is var_scale x the L1 model.
+  bool iono_free = false;
+  double var_scale = 1.0;
 };
 
 struct SppSolution {
