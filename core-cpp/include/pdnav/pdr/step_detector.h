@@ -148,6 +148,8 @@ class BoutGate {
   void set_short_walk_min_steps(int n) { short_min_ = n; }
   std::int64_t short_walk_steps() const { return short_walk_steps_; }
   bool in_bout() const { return in_bout_; }
+  /// Steps held, waiting for the bout to be confirmed.
+  std::size_t pending() const { return pending_.size(); }
 
  private:
   void release_pending(std::vector<T>& out) {
