@@ -211,11 +211,11 @@ void Pdr::feed(const StepDetectorSample& s) {
   if (opt_.source == StepSource::kAndroid || opt_.source == StepSource::kAuto) {
     // the swing of the accelerometer's own latest step (within 2 s), else the model's fallback
     const bool fresh = last_swing_ns_ >= 0 && std::abs(ns_to_s(s.t_ns - last_swing_ns_)) <= 2.0;
-    StepCandidate c;
-    c.t_ns = s.t_ns;
-    c.swing_mps2 = fresh ? last_swing_mps2_ : kNaN;
-    c.interval_s = 0.0;  // unknown: the length model's cadence fallback
-    emit_step(hold(c));
+    StepCandidate event;
+    event.t_ns = s.t_ns;
+    event.swing_mps2 = fresh ? last_swing_mps2_ : kNaN;
+    event.interval_s = 0.0;  // unknown: the length model's cadence fallback
+    emit_step(hold(event));
   }
   trim_consistency(s.t_ns);
 }
