@@ -89,7 +89,7 @@ class NaivePdr {
 
 struct WalkResult {
   std::string name;
-  std::vector<double> errors_m, naive_errors_m, seg_heading_err_deg;
+  std::vector<double> errors_m, naive_errors_m, seg_heading_err_deg, naive_seg_heading_err_deg;
   double mean_m = kNaN, naive_mean_m = kNaN, length_ratio = kNaN, naive_ratio = kNaN;
   std::int64_t steps = 0;
   double declination_deg = kNaN;
@@ -101,6 +101,17 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// Linear-interpolated percentile (0-100) of the finite values.
+double percentile(std::vector<double> v, double pct) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const double pos = pct / 100.0 * static_cast<double>(v.size() - 1);
+  const std::size_t lo = static_cast<std::size_t>(pos);
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
 double mean(const std::vector<double>& v) {
@@ -224,6 +235,13 @@ class Runner {
   std::int64_t steps_ = 0;
 };
 
+/// Heading error of an estimated displacement against the surveyed segment, degrees, + =
+/// clockwise; NaN when either is too short to have a direction.
+double segment_heading_error_deg(const Eigen::Vector2d& truth_en, const Eigen::Vector2d& est_en) {
+  if (truth_en.norm() <= 1.0 || est_en.norm() <= 0.5) return kNaN;
+  return wrap_pi(std::atan2(est_en.x(), est_en.y()) - std::atan2(truth_en.x(), truth_en.y())) / kDegToRad;
+}
+
 WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   WalkResult r;
   r.name = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
@@ -234,7 +252,7 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   bool started = false;
   const double declination = 0.0;  // naive: magnetic heading (see below)
   std::int64_t first_utc = kMissingInt;
-  std::vector<Eigen::Vector2d> truth_en, est_en;
+  std::vector<Eigen::Vector2d> truth_en, est_en, naive_en;
   double naive_path_m = 0;
   Eigen::Vector2d naive_last = Eigen::Vector2d::Zero();
   Sample s;
@@ -255,6 +273,7 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
         r.declination_deg = geo::magnetic_declination_rad(g, first_utc) / kDegToRad;
         truth_en.push_back(Eigen::Vector2d::Zero());
         est_en.push_back(Eigen::Vector2d::Zero());
+        naive_en.push_back(naive.pos_en());
         continue;
       }
       const Eigen::Vector2d tr = frame.to_enu(g).p_m.head<2>();
@@ -264,13 +283,14 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
       naive_last = naive.pos_en();
       r.errors_m.push_back((est - tr).norm());
       r.naive_errors_m.push_back((naive.pos_en() - tr).norm());
-      const Eigen::Vector2d dt = tr - truth_en.back(), de = est - est_en.back();
-      double herr = kNaN;
-      if (dt.norm() > 1.0 && de.norm() > 0.5)
-        herr = wrap_pi(std::atan2(de.x(), de.y()) - std::atan2(dt.x(), dt.y())) / kDegToRad;
-      r.seg_heading_err_deg.push_back(herr);
+      const Eigen::Vector2d dt = tr - truth_en.back();
+      r.seg_heading_err_deg.push_back(segment_heading_error_deg(dt, est - est_en.back()));
+      // the same for the naive PDR = the phone's own (magnetic) rotation-vector heading of +Y:
+      // separates what the map frame and the field give from what our fusion adds
+      r.naive_seg_heading_err_deg.push_back(segment_heading_error_deg(dt, naive.pos_en() - naive_en.back()));
       truth_en.push_back(tr);
       est_en.push_back(est);
+      naive_en.push_back(naive.pos_en());
       continue;
     }
     run.feed(s);
@@ -332,7 +352,7 @@ int run_eval_pdr(const EvalPdrArgs& a) {
     }
   }
   if (all.empty()) throw std::runtime_error("no walk could be evaluated");
-  std::vector<double> means, ratios, naive_means, herr;
+  std::vector<double> means, ratios, naive_means, herr, naive_herr;
   int wins = 0;
   for (const auto& r : all) {
     means.push_back(r.mean_m);
@@ -340,6 +360,7 @@ int run_eval_pdr(const EvalPdrArgs& a) {
     naive_means.push_back(r.naive_mean_m);
     wins += r.mean_m < r.naive_mean_m;
     for (double h : r.seg_heading_err_deg) herr.push_back(h);
+    for (double h : r.naive_seg_heading_err_deg) naive_herr.push_back(h);
   }
   std::vector<double> abs_herr;
   for (double h : herr) abs_herr.push_back(std::abs(h));
@@ -347,6 +368,10 @@ int run_eval_pdr(const EvalPdrArgs& a) {
               median(naive_means));
   std::printf("segment heading error: median signed %.1f deg, median |.| %.1f deg over %zu segments; WMM declination %.1f deg\n",
               median(herr), median(abs_herr), herr.size(), all.front().declination_deg);
+  std::printf("naive (rotation vector +Y, magnetic, no declination): segment heading error median signed %.1f deg\n",
+              median(naive_herr));
+  std::printf("per-walk mean error: p25 %.2f m, p75 %.2f m, max %.2f m\n", percentile(means, 25), percentile(means, 75),
+              percentile(means, 100));
   std::printf("median_mean_error_m: %.2f median_length_ratio: %.3f\n", median(means), median(ratios));
   return failed ? 1 : 0;
 }

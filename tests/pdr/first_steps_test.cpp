@@ -169,3 +169,48 @@ TEST(BoutGate, ShortWalkReleasedWhenItEndsButTwoStepsAreNot) {
   EXPECT_TRUE(gate.push(s_to_ns(11.2), 8).empty());
   EXPECT_TRUE(gate.finish().empty());
 }
+
+namespace {
+/// Standing, `n_steps` steps (one |a| cycle of 0.55 s each), standing; with or without a gyro
+/// (a still phone: 0.02 rad/s noise, 0.005 rad/s bias per axis) at 100 Hz.
+std::size_t steps_of_short_walk(int n_steps, bool with_gyro, PdrOptions opt) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.05), gyro_noise(0.0, 0.02);
+  const double rate_hz = 100.0, step_s = 0.55, walk_from_s = 3.0;
+  Pdr pdr(opt);
+  std::size_t n = 0;
+  for (int i = 0; i < static_cast<int>((walk_from_s + n_steps * step_s + 4.0) * rate_hz); ++i) {
+    const double t = i / rate_hz;
+    const bool walking = t >= walk_from_s && t < walk_from_s + n_steps * step_s;
+    const double m =
+        kStandardGravity_mps2 + (walking ? 2.5 * std::sin(2 * kPi * (t - walk_from_s) / step_s) : 0.0) + noise(rng);
+    const TimeNs t_ns = s_to_ns(1.0 + t);
+    if (with_gyro) {
+      pdr.feed(GyroSample{t_ns, kMissingInt,
+                          Eigen::Vector3d(0.005 + gyro_noise(rng), -0.005 + gyro_noise(rng), 0.005 + gyro_noise(rng))});
+    }
+    pdr.feed(AccelSample{t_ns, kMissingInt, Eigen::Vector3d(0.3 * m, 0.8 * m, 0.52 * m)});
+    n += pdr.take_steps().size();
+  }
+  pdr.finish();
+  return n + pdr.take_steps().size();
+}
+}  // namespace
+
+TEST(FirstSteps, TwoStepsBetweenPausesCountWhenTheHandlingGateCanRefuseJolts) {
+  // Stepping on to the next spot and stopping (ILC survey walks: 1-2 m to a waypoint). With a
+  // live gyroscope the motion classifier refuses handling, so two regular steps are a walk;
+  // without one (or with the handling gate off) two steps stay "as likely a jolt".
+  const std::size_t with_gyro = steps_of_short_walk(2, true, PdrOptions{});
+  const std::size_t accel_only = steps_of_short_walk(2, false, PdrOptions{});
+  PdrOptions no_gate;
+  no_gate.gate_handling = false;
+  const std::size_t gyro_no_gate = steps_of_short_walk(2, true, no_gate);
+  std::printf("two-step walk: %zu steps with a gyro, %zu accelerometer only, %zu with the handling gate off\n",
+              with_gyro, accel_only, gyro_no_gate);
+  EXPECT_EQ(with_gyro, 2u);
+  EXPECT_EQ(accel_only, 0u);
+  EXPECT_EQ(gyro_no_gate, 0u);
+  // one step alone is never a walk
+  EXPECT_EQ(steps_of_short_walk(1, true, PdrOptions{}), 0u);
+}

@@ -58,8 +58,13 @@ void Pdr::feed(const AccelSample& s) {
   classifier_.feed(s);
   const bool handling = opt_.gate_handling && classifier_.state() == MotionState::kHandling;
   if (handling) placement_.end_bout();  // the phone is being moved: re-estimate afterwards
-  else placement_.feed(s, gate_.in_bout());
+  else placement_.feed(s, gate_.in_bout() || gate_.pending() > 0);  // first steps teach it too
   sync_placement();
+  flush_undecided(s.t_ns, false);
+  // two steps between pauses count as a walk only while the handling gate can refuse jolts
+  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(s.t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
+  gate_.set_short_walk_min_steps(opt_.gate_handling && gyro_live ? opt_.detector.short_walk_min_steps_gyro
+                                                                 : opt_.detector.short_walk_min_steps);
   const auto candidates = detector_.feed(s);
   if (detector_.counters().gaps != gaps_seen_) {  // a gap resets the detector and the bout
     gaps_seen_ = detector_.counters().gaps;
@@ -90,7 +95,46 @@ Pdr::HeldStep Pdr::hold(const StepCandidate& c) const {
   h.magnetic = fusion_.valid();
   h.heading_rad = wrap_two_pi(heading_rad() - (h.magnetic ? declination_rad_ : 0.0));
   h.heading_sigma_rad = heading_sigma_rad();
+  if (opt_.heading.mount == Mount::kAuto) {
+    h.offset_rad = placement_.forward_offset_rad();
+    // a step before the bout's gravity is known belongs to the bout that starts next
+    h.placement_revision = placement_.revision() + (placement_.in_bout() ? 0 : 1);
+    h.reference_phone = placement_.reference_phone();
+  }
   return h;
+}
+
+Pdr::HeldStep Pdr::reprojected(HeldStep h) const {
+  // same placement bout: the reference axis' heading stays, the walking offset is the latest
+  if (opt_.heading.mount != Mount::kAuto || h.placement_revision != placement_.revision() ||
+      !placement_.in_bout() || h.reference_phone != placement_.reference_phone())
+    return h;
+  const double now = placement_.forward_offset_rad();
+  h.heading_rad = wrap_two_pi(h.heading_rad + now - h.offset_rad);
+  h.offset_rad = now;
+  return h;
+}
+
+void Pdr::deliver(HeldStep h, TimeNs now_ns) {
+  const bool wait = opt_.heading.mount == Mount::kAuto && opt_.placement.max_direction_wait_s > 0.0 &&
+                    h.placement_revision == placement_.revision() && !placement_.direction_known();
+  if (wait) {
+    undecided_.push_back(h);
+    return;
+  }
+  flush_undecided(now_ns, true);
+  emit_step(reprojected(h));
+}
+
+void Pdr::flush_undecided(TimeNs now_ns, bool force) {
+  if (undecided_.empty()) return;
+  const bool decided = placement_.direction_known() || undecided_.front().placement_revision != placement_.revision();
+  const bool too_old = ns_to_s(now_ns - undecided_.front().candidate.t_ns) > opt_.placement.max_direction_wait_s;
+  if (!force && !decided && !too_old) return;
+  while (!undecided_.empty()) {
+    emit_step(reprojected(undecided_.front()));
+    undecided_.pop_front();
+  }
 }
 
 void Pdr::release(const std::vector<HeldStep>& steps, TimeNs now_ns) {
@@ -98,11 +142,14 @@ void Pdr::release(const std::vector<HeldStep>& steps, TimeNs now_ns) {
     accel_step_times_.push_back(h.candidate.t_ns);
     const bool use = opt_.source == StepSource::kAccelerometer ||
                      (opt_.source == StepSource::kAuto && !android_active(now_ns));
-    if (use) emit_step(h);
+    if (use) deliver(h, now_ns);
   }
 }
 
-void Pdr::finish() { release(gate_.finish(), latest_ns_); }
+void Pdr::finish() {
+  release(gate_.finish(), latest_ns_);
+  flush_undecided(latest_ns_, true);
+}
 
 void Pdr::feed(const GyroSample& s) {
   tracker_.feed(s);
@@ -164,11 +211,11 @@ void Pdr::feed(const StepDetectorSample& s) {
   if (opt_.source == StepSource::kAndroid || opt_.source == StepSource::kAuto) {
     // the swing of the accelerometer's own latest step (within 2 s), else the model's fallback
     const bool fresh = last_swing_ns_ >= 0 && std::abs(ns_to_s(s.t_ns - last_swing_ns_)) <= 2.0;
-    StepCandidate c;
-    c.t_ns = s.t_ns;
-    c.swing_mps2 = fresh ? last_swing_mps2_ : kNaN;
-    c.interval_s = 0.0;  // unknown: the length model's cadence fallback
-    emit_step(hold(c));
+    StepCandidate event;
+    event.t_ns = s.t_ns;
+    event.swing_mps2 = fresh ? last_swing_mps2_ : kNaN;
+    event.interval_s = 0.0;  // unknown: the length model's cadence fallback
+    emit_step(hold(event));
   }
   trim_consistency(s.t_ns);
 }

@@ -34,6 +34,7 @@ void PlacementEstimator::start_bout(TimeNs t_ns) {
   corr_.setZero();
   cov_h_.setZero();
   var_v_ = n_corr_ = walking_s_ = 0.0;
+  prior_supported_ = false;
   // placement from the dominant gravity axis; the reference axis is the placement's prior
   // walking axis (flat: +Y, upright: -Z), else the most horizontal of +X, +Y, -Z
   const double ax = std::abs(up_.x()), ay = std::abs(up_.y()), az = std::abs(up_.z());
@@ -114,6 +115,7 @@ void PlacementEstimator::update_forward() {
                                                                       : Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
     double c = 0.0;
     const double vf = prior.dot(cov_h_ * prior);
+    prior_supported_ = var_v_ > 0.0 && vf > 0.0 && prior.dot(corr_) > 0.0;
     if (trusted && vf > 0.0) c = prior.dot(corr_) / std::sqrt(var_v_ * vf);
     bout_.phase_corr = c;
     bout_.forward_phone = (trusted && c < opt_.flip_corr) ? Eigen::Vector3d(-prior) : prior;

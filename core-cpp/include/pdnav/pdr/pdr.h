@@ -132,9 +132,17 @@ class Pdr {
     double heading_rad = 0.0;  // magnetic if `magnetic`, else true
     double heading_sigma_rad = 0.0;
     bool magnetic = false;
+    double offset_rad = 0.0;               // placement offset (reference axis -> walking) used
+    std::int64_t placement_revision = -1;  // placement bout it was taken in (or the next one)
+    Eigen::Vector3d reference_phone = Eigen::Vector3d::Zero();  // axis its heading refers to
   };
   HeldStep hold(const StepCandidate& c) const;
   void release(const std::vector<HeldStep>& steps, TimeNs now_ns);
+  /// Emits a released step, or holds it while its placement bout's walking direction is
+  /// still the prior (first steps); the held ones are re-projected when it is decided.
+  void deliver(HeldStep h, TimeNs now_ns);
+  void flush_undecided(TimeNs now_ns, bool force);
+  HeldStep reprojected(HeldStep h) const;
   void emit_step(const HeldStep& h);
   bool android_active(TimeNs t_ns) const;
   void trim_consistency(TimeNs t_ns);
@@ -174,6 +182,7 @@ class Pdr {
   TimeNs latest_ns_ = 0;
   // outputs
   std::vector<PdrStep> steps_;
+  std::deque<HeldStep> undecided_;  // released, waiting for the walking direction
   std::vector<char> steps_magnetic_;  // per steps_ entry: heading still magnetic
   std::int64_t step_count_ = 0;
   std::deque<TimeNs> accel_step_times_, android_step_times_;

@@ -40,6 +40,12 @@ struct PlacementOptions {
   double phase_lag_s = 0.14;           // a quarter of a 0.55 s step (1.8 Hz cadence)
   double flip_corr = -0.25;            // flat/upright prior reversed only below this correlation
   double min_bout_s = 2.0;             // correlation trusted after this much walking in a bout
+  // Steps taken before that (the first steps of a bout) are held by Pdr at most this long for
+  // the direction, then re-projected with it (docs/pdr.md "First steps"); 0 = no waiting.
+  double max_direction_wait_s = 3.0;
+  // ... but only while the motion contradicts the placement's prior axis: after this much
+  // walking with a positive phase correlation along the prior, the prior stands (no wait).
+  double prior_confirm_s = 0.5;
 };
 
 /// A placement bout: from t_start_ns to t_end_ns (last sample so far for the open one).
@@ -61,6 +67,8 @@ class PlacementEstimator {
   void end_bout();
 
   bool ready() const { return have_up_; }
+  /// A placement bout is open (false before the first and between a handling span and the next).
+  bool in_bout() const { return in_bout_; }
   const Eigen::Vector3d& up_phone() const { return up_; }
   Placement placement() const { return bout_.placement; }
   /// Walking direction in phone axes for the current bout (unit, horizontal at bout start).
@@ -73,6 +81,12 @@ class PlacementEstimator {
   /// Clockwise angle (rad) from the horizontal projection of reference_phone() to that of
   /// forward_phone() under the current gravity; 0 when either is near vertical.
   double forward_offset_rad() const;
+  /// The walking direction of the current bout has been decided from the motion (enough
+  /// walking for the phase correlation), not just the placement's prior.
+  /// Or the bout has a prior axis (flat, upright) that the motion so far supports.
+  bool direction_known() const {
+    return in_bout_ && (walking_s_ >= opt_.min_bout_s || (walking_s_ >= opt_.prior_confirm_s && prior_supported_));
+  }
   /// Every bout so far (closed ones and the open one last).
   std::vector<PlacementBout> bouts() const;
 
@@ -101,6 +115,7 @@ class PlacementEstimator {
   double var_v_ = 0.0, n_corr_ = 0.0;
   Eigen::Matrix3d cov_h_ = Eigen::Matrix3d::Zero();
   double walking_s_ = 0.0;
+  bool prior_supported_ = false;  // running phase correlation along the prior axis > 0
 };
 
 }  // namespace pdnav::pdr

@@ -54,6 +54,11 @@ struct StepDetectorOptions {
   // A walk shorter than the bout (issue 19.6) still counts once it ends, if it has at least
   // this many regular steps (3 = a 2 m walk; 2 steps alone are as likely a jolt). 0 = off.
   int short_walk_min_steps = 3;
+  // The same with a live gyroscope (Pdr only): the motion classifier then refuses handling and
+  // waving (docs/pdr.md "Motion classifier"), which is what made two steps "as likely a jolt",
+  // so two regular steps between two pauses count: stepping on to the next spot and stopping
+  // (on the ILC survey walks, 1-2 m to a waypoint; measured in docs/pdr.md "First steps").
+  int short_walk_min_steps_gyro = 2;
   double max_step_interval_s = 1.3;    // longer pause ends the bout (cadence >= ~0.8 Hz)
   // --- Swinging hand (issue 20.1, docs/pdr.md "Swinging hand"): an arm swings at the STRIDE
   // frequency, so |a| peaks once per stride and the level crossings count every other step.
@@ -139,8 +144,12 @@ class BoutGate {
     return out;
   }
   std::int64_t discarded() const { return discarded_; }
+  /// Minimum length of a short walk from now on (0 = off); see StepDetectorOptions.
+  void set_short_walk_min_steps(int n) { short_min_ = n; }
   std::int64_t short_walk_steps() const { return short_walk_steps_; }
   bool in_bout() const { return in_bout_; }
+  /// Steps held, waiting for the bout to be confirmed.
+  std::size_t pending() const { return pending_.size(); }
 
  private:
   void release_pending(std::vector<T>& out) {
