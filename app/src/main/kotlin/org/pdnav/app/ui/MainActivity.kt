@@ -99,6 +99,7 @@ class MainActivity : Activity() {
             s.lastOutput?.let { showOutput(it, s.track) }
             s.lastStats?.let { showStats(it) }
             s.lastError?.let { status.text = getString(R.string.status_error, it) }
+            s.replayState?.let { listener.onReplay(it.output, it.fraction, it.done, it.error) }  // e.g. after a rotation
             pendingReplay?.let {
                 pendingReplay = null
                 startReplay(it)
@@ -456,7 +457,7 @@ class MainActivity : Activity() {
             addView(counters)
             addView(locationPanel)
             addView(interruptedPanel)
-            addView(skyPlot, LinearLayout.LayoutParams(-1, Views.dp(context, 200)))
+            addView(skyPlot, LinearLayout.LayoutParams(-1, Views.dp(context, 264)))
         }
         root.addView(top, FrameLayout.LayoutParams(-1, -2, Gravity.TOP))
 
