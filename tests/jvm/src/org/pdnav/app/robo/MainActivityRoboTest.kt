@@ -211,7 +211,12 @@ class MainActivityRoboTest {
         shadowOf(app).setComponentNameAndServiceForBindService(ComponentName(app, NavigationService::class.java),
             service.onBind(Intent(app, NavigationService::class.java)))
         val log = TestPaths.sharedData("gnss-mountainview/pseudoranges_log_2016_08_22_14_45_50.txt")
-        val intent = Intent(app, MainActivity::class.java).putExtra(MainActivity.EXTRA_REPLAY, log.path)
+        // the replay reads a named pipe: it waits in open() until the test writes the log, so it
+        // is certainly still running when the screen rotates (a file this small replays in ms)
+        val fifo = java.io.File(TestPaths.scratch("rotation"), log.name)
+        val mk = ProcessBuilder("mkfifo", fifo.path).redirectErrorStream(true).start()
+        assertTrue(mk.waitFor(30, java.util.concurrent.TimeUnit.SECONDS) && mk.exitValue() == 0, "mkfifo $fifo")
+        val intent = Intent(app, MainActivity::class.java).putExtra(MainActivity.EXTRA_REPLAY, fifo.path)
         val controller = Robolectric.buildActivity(MainActivity::class.java, intent).setup()
         shadowOf(Looper.getMainLooper()).idle()
         val task = assertNotNull(service.replay, "the replay runs in the service")
@@ -219,13 +224,17 @@ class MainActivityRoboTest {
         controller.recreate()
         shadowOf(Looper.getMainLooper()).idle()
         assertFalse(task.isCancelled, "the rotation cancelled the replay")
-        val now = service.replay
-        assertTrue(now == null || now === task, "the rotation started a second replay")
+        assertTrue(service.replay === task, "the rotation started a second replay")
+        val writer = Thread {
+            java.io.FileOutputStream(fifo).use { out -> log.inputStream().use { it.copyTo(out) } }
+        }.apply { isDaemon = true; start() }
+        writer.join(60_000)
+        assertFalse(writer.isAlive, "nobody reads the replay's pipe")
         task.join(120_000)
         shadowOf(Looper.getMainLooper()).idle()
         assertNull(service.replay, "the replay ended (and no other one was started)")
         val status = controller.get().findViewById<TextView>(R.id.status_text).text.toString()
-        assertTrue(status.startsWith(app.getString(R.string.status_replay_done, log.name)),
+        assertTrue(status.startsWith(app.getString(R.string.status_replay_done, fifo.name)),
             "the re-created screen shows the replay's end: $status")
         controller.destroy()
     }

@@ -24,9 +24,9 @@ import kotlin.math.sqrt
 class SensorSource(
     private val sensors: SensorManager,
     private val merger: SampleMerger,
-    private val onEvent: () -> Unit = {},
     /** Clock of onAccuracyChanged rows (the callback has no timestamp): elapsedRealtimeNanos, UTC ms. */
     private val clock: () -> Pair<Long, Long> = { SystemClock.elapsedRealtimeNanos() to System.currentTimeMillis() },
+    private val onEvent: () -> Unit = {},
 ) : SensorEventListener {
 
     /** One sensor subscription: type, sampling period and allowed report latency, minimum API. */
