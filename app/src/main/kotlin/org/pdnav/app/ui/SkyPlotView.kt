@@ -29,6 +29,8 @@ class SkyPlotView(context: Context) : View(context) {
     private val grid = Paint(Paint.ANTI_ALIAS_FLAG).apply { color = Color.GRAY; style = Paint.Style.STROKE; strokeWidth = density }
     private val sat = Paint(Paint.ANTI_ALIAS_FLAG)
     private val text = Paint(Paint.ANTI_ALIAS_FLAG).apply { color = Color.DKGRAY; textSize = 10 * density }
+    /** A white halo under the svid labels, so a label over a grid line stays readable. */
+    private val halo = Paint(text).apply { color = Color.WHITE; style = Paint.Style.STROKE; strokeWidth = 3 * density }
     private val barText = Paint(Paint.ANTI_ALIAS_FLAG).apply { color = Color.DKGRAY; textSize = 9 * density; textAlign = Paint.Align.CENTER }
 
     /** Height of the C/N0 bar strip (bars and their svid labels) at the bottom, px. */
@@ -93,6 +95,7 @@ class SkyPlotView(context: Context) : View(context) {
             sat.strokeWidth = 2 * density
             val size = dotRadius(s.cn0DbHz)
             c.drawCircle(p[0], p[1], size, sat)
+            c.drawText(s.svid.toString(), p[0] + size, p[1] - size, halo)
             c.drawText(s.svid.toString(), p[0] + size, p[1] - size, text)
         }
         // C/N0 bars; labels only where a slot is wide enough for them
