@@ -131,6 +131,11 @@ void fields(Io& io, S& s) {
     io.d(0, s.lat_deg); io.d(1, s.lon_deg); io.d(2, s.h_m); io.d(3, s.heading_deg);
   } else if constexpr (std::is_same_v<T, MetaSample>) {
     io.s(0, s.key); io.s(1, s.value);
+  } else if constexpr (std::is_same_v<T, GameRotationVectorSample>) {
+    io.i(0, s.utc_ms);
+    for (std::size_t k = 0; k < 4; ++k) io.d(k, s.quat_xyzw[static_cast<Eigen::Index>(k)]);
+  } else if constexpr (std::is_same_v<T, SensorAccuracySample>) {
+    io.i(0, s.utc_ms); io.i(1, s.sensor_type); io.i(2, s.accuracy);
   } else {
     static_assert(sizeof(T) == 0, "sample type without a field map");
   }

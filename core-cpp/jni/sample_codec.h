@@ -1,7 +1,7 @@
 // The batch layout shared by the JNI bridge and the Kotlin SampleBatch class
 // (app/src/main/kotlin/org/pdnav/app/nav/SampleBatch.kt): every sample is one row of
 // fixed-width primitive arrays, so a whole batch crosses JNI in a handful of array copies.
-//   kind     int32   pdnav::Sample variant index (0 Accel ... 17 Meta)
+//   kind     int32   pdnav::Sample variant index (0 Accel ... 17 Meta, 18 GameRotationVector, 19 SensorAccuracy)
 //   t_ns     int64   elapsedRealtimeNanos
 //   ints     int64 x kInts      integer fields (utc_ms first where the type has it)
 //   doubles  float64 x kDoubles  real fields (core units: m/s^2, rad/s, uT, Pa, deg, m)

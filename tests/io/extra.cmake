@@ -16,3 +16,10 @@ set_tests_properties(io_inspect_excerpt PROPERTIES LABELS "io;cli"
 
 add_test(NAME io_inspect_missing_file COMMAND pdnav inspect "${CMAKE_CURRENT_BINARY_DIR}/no-such-log.txt")
 set_tests_properties(io_inspect_missing_file PROPERTIES LABELS "io;cli" WILL_FAIL TRUE)
+
+# pdnav's own line types GameRotationVector and SensorAccuracy are counted like any other
+# (the fuzz seed: 2 + 4 good lines, one accuracy 7 and one short quaternion skipped)
+add_test(NAME io_inspect_game_rotation_and_accuracy
+         COMMAND pdnav inspect "${PROJECT_SOURCE_DIR}/tests/fuzz-corpus/log_reader/game_rotation_and_accuracy.txt")
+set_tests_properties(io_inspect_game_rotation_and_accuracy PROPERTIES LABELS "io;cli"
+  PASS_REGULAR_EXPRESSION "GameRotationVector +2 .*SensorAccuracy +4 .*value out of range: 1.*wrong field count: 1.*samples: 8 skipped: 2\n")

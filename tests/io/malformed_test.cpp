@@ -159,6 +159,36 @@ TEST(Malformed, ValuesOutOfRangeAreSkipped) {
   EXPECT_EQ(skipped(r.stats, "value out of range"), 2);
 }
 
+TEST(Malformed, SensorAccuracyOutsideAndroidsValuesIsSkipped) {
+  // SensorAccuracy,utcTimeMillis,elapsedRealtimeNanos,SensorType,Accuracy
+  const auto r = read_text("SensorAccuracy,1000,5000,2,3\nSensorAccuracy,1000,6000,2,4\n"
+                           "SensorAccuracy,1000,7000,0,1\nSensorAccuracy,1000,8000,2,x\n"
+                           "SensorAccuracy,1000,9000,2\nSensorAccuracy,1000,9500,2,-1\n");
+  ASSERT_EQ(r.samples.size(), 2u);
+  EXPECT_EQ(std::get<SensorAccuracySample>(r.samples[0]).sensor_type, 2);
+  EXPECT_EQ(std::get<SensorAccuracySample>(r.samples[0]).accuracy, 3);
+  EXPECT_EQ(std::get<SensorAccuracySample>(r.samples[1]).accuracy, -1);
+  EXPECT_EQ(skipped(r.stats, "value out of range"), 2);
+  EXPECT_EQ(skipped(r.stats, "non-numeric value"), 1);
+  EXPECT_EQ(skipped(r.stats, "wrong field count"), 1);
+  ASSERT_GE(r.stats.issues.size(), 2u);
+  EXPECT_EQ(r.stats.issues[0].to_string(), "mem:2: value out of range: Accuracy 4 is not a SENSOR_STATUS (-1..3)");
+  EXPECT_EQ(r.stats.issues[1].to_string(), "mem:3: value out of range: SensorType 0 is not an Android sensor type (> 0)");
+}
+
+TEST(Malformed, GameRotationVectorHasNoHeadingAccuracyColumn) {
+  // like RotationVector but without HeadingAccuracyRad: 7 fields, not 8
+  const auto r = read_text("GameRotationVector,1000,5000,0.1,0.2,0.3,0.927\n"
+                           "GameRotationVector,1000,6000,0.1,0.2,0.3,0.927,0.05\n"
+                           "GameRotationVector,1000,7000,0.1,zz,0.3,0.927\n");
+  ASSERT_EQ(r.samples.size(), 1u);
+  const auto& q = std::get<GameRotationVectorSample>(r.samples[0]);
+  EXPECT_EQ(q.t_ns, 5000);
+  EXPECT_EQ(q.quat_xyzw[3], 0.927);
+  EXPECT_EQ(skipped(r.stats, "wrong field count"), 1);
+  EXPECT_EQ(skipped(r.stats, "non-numeric value"), 1);
+}
+
 TEST(Time, LinesWithOnlyUtcWaitForAnOffsetThenMapThroughIt) {
   // Status has UnixTimeMillis only (GnssLogger): before any sensor line there is no base.
   const std::string status = "# Status,UnixTimeMillis,SignalCount,SignalIndex,ConstellationType,Svid,"

@@ -106,6 +106,8 @@ template <int N>
 #define AGC(F) F(t_ns) F(utc_ms) F(time_nanos) F(agc_db) F(carrier_frequency_hz) F(constellation_type)
 #define TRUTH(F) F(t_ns) F(lat_deg) F(lon_deg) F(h_m) F(heading_deg)
 #define META(F) F(t_ns) F(key) F(value)
+#define GAMEROTVEC(F) F(t_ns) F(utc_ms) F(quat_xyzw)
+#define SENSACC_CHECK(F) F(t_ns) F(utc_ms) F(sensor_type) F(accuracy)
 
 #define FILL_FIELD(f) fill_value(s.f, g);
 #define CHECK_FIELD(f) EXPECT_TRUE(same(a.f, b.f)) << ctx << " field " #f;
@@ -130,6 +132,16 @@ SAMPLE_TYPE(GnssStatusSample, STATUS)
 SAMPLE_TYPE(AgcSample, AGC)
 SAMPLE_TYPE(TruthSample, TRUTH)
 SAMPLE_TYPE(MetaSample, META)
+SAMPLE_TYPE(GameRotationVectorSample, GAMEROTVEC)
+// SensorAccuracy: the reader accepts only Android's values (sensor type > 0, SENSOR_STATUS -1..3).
+void fill_sample(SensorAccuracySample& s, Gen& g) {
+  s.utc_ms = random_i64(g);
+  s.sensor_type = static_cast<int>(g() % 40 + 1);
+  s.accuracy = static_cast<int>(g() % 5) - 1;
+}
+void check_sample(const SensorAccuracySample& a, const SensorAccuracySample& b, const std::string& ctx) {
+  SENSACC_CHECK(CHECK_FIELD)
+}
 
 template <std::size_t... I> Sample make_sample(std::size_t k, std::index_sequence<I...>) {
   Sample s;

@@ -477,6 +477,12 @@ template <std::size_t I> void ReaderCore::parse_as(Sample& out) {
       reader.times.elapsed_ms = ms;
     }
   }
+  if constexpr (std::is_same_v<S, SensorAccuracySample>) {
+    if (s.accuracy < -1 || s.accuracy > 3)
+      throw LineError{kOutOfRange, "Accuracy " + std::to_string(s.accuracy) + " is not a SENSOR_STATUS (-1..3)"};
+    if (s.sensor_type <= 0)
+      throw LineError{kOutOfRange, "SensorType " + std::to_string(s.sensor_type) + " is not an Android sensor type (> 0)"};
+  }
   const bool direct = place(s, reader.times);
   check_order(I, out, s.t_ns);
   if (direct) learn_offset(s, s.t_ns);

@@ -47,6 +47,8 @@ PDNAV_LINE(GnssStatusSample, "Status", kWall, false)
 PDNAV_LINE(AgcSample, "Agc", kGnss, false)
 PDNAV_LINE(TruthSample, "Truth", kNone, false)
 PDNAV_LINE(MetaSample, "Meta", kNone, false)
+PDNAV_LINE(GameRotationVectorSample, "GameRotationVector", kWall, true)
+PDNAV_LINE(SensorAccuracySample, "SensorAccuracy", kWall, false)
 #undef PDNAV_LINE
 
 inline constexpr std::size_t kNumLineTypes = std::variant_size_v<Sample>;
@@ -205,6 +207,17 @@ template <class V> void visit_fields(MetaSample& s, V& v) {
   v.elapsed("elapsedRealtimeNanos", s.t_ns);
   v.text("Key", s.key);
   v.text("Value", s.value);
+}
+
+template <class V> void visit_fields(GameRotationVectorSample& s, V& v) {
+  sensor_time(s.utc_ms, s.t_ns, v);
+  v.f64("QuatX", s.quat_xyzw[0]); v.f64("QuatY", s.quat_xyzw[1]); v.f64("QuatZ", s.quat_xyzw[2]); v.f64("QuatW", s.quat_xyzw[3]);
+}
+
+template <class V> void visit_fields(SensorAccuracySample& s, V& v) {
+  sensor_time(s.utc_ms, s.t_ns, v);
+  v.i32("SensorType", s.sensor_type);
+  v.i32("Accuracy", s.accuracy);
 }
 
 /// Collects the canonical column names of a line type, in schema order.

@@ -140,10 +140,21 @@ struct MetaSample {
   std::string value;
 };
 
+/// Game rotation vector (TYPE_GAME_ROTATION_VECTOR): unit quaternion phone->a world frame
+/// whose Z is up but whose yaw is arbitrary (gyro + accelerometer, no magnetometer), x,y,z,w.
+struct GameRotationVectorSample { TimeNs t_ns = 0; std::int64_t utc_ms = kMissingInt; Eigen::Vector4d quat_xyzw = Eigen::Vector4d(0, 0, 0, 1); };
+
+/// A sensor's accuracy change (SensorEventListener.onAccuracyChanged): Android sensor type
+/// (Sensor.TYPE_*, e.g. 2 magnetic field) and SensorManager.SENSOR_STATUS_* (-1 no contact,
+/// 0 unreliable, 1 low, 2 medium, 3 high). t_ns is the elapsed time of the callback.
+struct SensorAccuracySample { TimeNs t_ns = 0; std::int64_t utc_ms = kMissingInt; int sensor_type = 0; int accuracy = 0; };
+
+// New line types are appended: the variant index is the JNI batch kind (core-cpp/jni).
 using Sample = std::variant<AccelSample, GyroSample, MagSample, UncalAccelSample, UncalGyroSample,
                             UncalMagSample, OrientationSample, PressureSample, RotationVectorSample,
                             StepDetectorSample, StepCounterSample, GnssRawSample, FixSample,
-                            NavMessageSample, GnssStatusSample, AgcSample, TruthSample, MetaSample>;
+                            NavMessageSample, GnssStatusSample, AgcSample, TruthSample, MetaSample,
+                            GameRotationVectorSample, SensorAccuracySample>;
 
 /// Timestamp of any sample.
 inline TimeNs sample_time_ns(const Sample& s) {

@@ -39,6 +39,8 @@ class RecorderRoundTripTest {
         addFix(t0 + 8, fix)
         addNavMessage(t0 + 9, 23, 0x0101, 1, 3, 2, navData)
         addUncalibrated(SampleKind.UNCAL_GYRO, t0 + 10, doubleArrayOf(0.01, 0.02, 0.03), doubleArrayOf(1e-3, 2e-3, 3e-3))
+        addGameRotationVector(t0 + 11, -0.5, 0.25, 0.125, 0.8196798, utcMs = 1_700_000_000_777L)
+        addSensorAccuracy(t0 + 12, 2, 1, utcMs = 1_700_000_000_778L)  // TYPE_MAGNETIC_FIELD, SENSOR_STATUS_ACCURACY_LOW
     }
 
     @Test
@@ -58,7 +60,7 @@ class RecorderRoundTripTest {
             assertEquals(written.tNs(i), back.tNs(i), "time of row $i")
         }
         assertEquals("UserHeightMeters", back.string(0, 0)); assertEquals("1.82", back.string(0, 1))
-        for ((row, n) in listOf(1 to 3, 2 to 3, 3 to 3, 5 to 5, 10 to 6)) {
+        for ((row, n) in listOf(1 to 3, 2 to 3, 3 to 3, 5 to 5, 10 to 6, 11 to 4)) {
             for (k in 0 until n) assertEquals(written.double(row, k), back.double(row, k), "row $row value $k")
         }
         assertTrue(abs(back.double(4, 0) - 95_432.1) < 1e-6, "pressure (Pa, stored in hPa): ${back.double(4, 0)}")
@@ -66,6 +68,8 @@ class RecorderRoundTripTest {
         assertEquals(fix, back.fix(8))
         assertEquals(navData.toList(), back.navData(9).toList())
         for (k in 0..4) assertEquals(written.long(9, k), back.long(9, k), "nav field $k")
+        assertEquals(1_700_000_000_777L, back.long(11, 0), "game rotation vector UTC")
+        for (k in 0..2) assertEquals(written.long(12, k), back.long(12, k), "sensor accuracy field $k")
     }
 
     @Test
@@ -81,6 +85,18 @@ class RecorderRoundTripTest {
         assertEquals(37.422578, column(file, "Fix", "LatitudeDegrees").toDouble())
         assertEquals(-122.081678, column(file, "Fix", "LongitudeDegrees").toDouble())
         assertEquals(-9.80665, column(file, "Accel", "AccelYMps2").toDouble())
+        assertEquals(-0.5, column(file, "GameRotationVector", "QuatX").toDouble())
+        assertEquals(0.8196798, column(file, "GameRotationVector", "QuatW").toDouble())
+        assertEquals("2", column(file, "SensorAccuracy", "SensorType"))
+        assertEquals("1", column(file, "SensorAccuracy", "Accuracy"))
+    }
+
+    @Test
+    fun sensorAccuracyOutsideAndroidsValuesIsRefusedBeforeTheLog() {
+        val b = SampleBatch()
+        kotlin.test.assertFailsWith<IllegalArgumentException> { b.addSensorAccuracy(1L, 2, 4) }
+        kotlin.test.assertFailsWith<IllegalArgumentException> { b.addSensorAccuracy(1L, 0, 3) }
+        assertEquals(0, b.size)
     }
 
     @Test

@@ -1,6 +1,9 @@
 package org.pdnav.app.robo
 
 import android.Manifest
+import android.content.ComponentName
+import android.content.Intent
+import android.os.Looper
 import android.content.pm.PackageManager
 import android.view.View
 import android.widget.Button
@@ -11,6 +14,7 @@ import org.pdnav.app.R
 import org.pdnav.app.map.MapController
 import org.pdnav.app.nav.NavEstimate
 import org.pdnav.app.nav.NavOutput
+import org.pdnav.app.nav.TestPaths
 import org.pdnav.app.sensors.NavigationService
 import org.pdnav.app.ui.AppSettings
 import org.pdnav.app.ui.MainActivity
@@ -197,5 +201,41 @@ class MainActivityRoboTest {
         val eastMost = pts.maxOf { it.longitude }
         val eastM = (eastMost - 1.5) * Math.PI / 180 * 6_371_000.0 * Math.cos(Math.toRadians(42.5))
         assertTrue(abs(eastM - MapController.K95 * 4.0) < 0.05, "east extent $eastM m")
+    }
+
+    @Test
+    fun aRotationDuringAReplayKeepsTheReplayRunningInTheService() {
+        shadowOf(app).grantPermissions(Manifest.permission.ACCESS_FINE_LOCATION, Manifest.permission.ACCESS_COARSE_LOCATION,
+            Manifest.permission.ACTIVITY_RECOGNITION)
+        val service = Robolectric.buildService(NavigationService::class.java).create().get()
+        shadowOf(app).setComponentNameAndServiceForBindService(ComponentName(app, NavigationService::class.java),
+            service.onBind(Intent(app, NavigationService::class.java)))
+        val log = TestPaths.sharedData("gnss-mountainview/pseudoranges_log_2016_08_22_14_45_50.txt")
+        // the replay reads a named pipe: it waits in open() until the test writes the log, so it
+        // is certainly still running when the screen rotates (a file this small replays in ms)
+        val fifo = java.io.File(TestPaths.scratch("rotation"), log.name)
+        val mk = ProcessBuilder("mkfifo", fifo.path).redirectErrorStream(true).start()
+        assertTrue(mk.waitFor(30, java.util.concurrent.TimeUnit.SECONDS) && mk.exitValue() == 0, "mkfifo $fifo")
+        val intent = Intent(app, MainActivity::class.java).putExtra(MainActivity.EXTRA_REPLAY, fifo.path)
+        val controller = Robolectric.buildActivity(MainActivity::class.java, intent).setup()
+        shadowOf(Looper.getMainLooper()).idle()
+        val task = assertNotNull(service.replay, "the replay runs in the service")
+        // the rotation: the Activity is destroyed and re-created with its saved state
+        controller.recreate()
+        shadowOf(Looper.getMainLooper()).idle()
+        assertFalse(task.isCancelled, "the rotation cancelled the replay")
+        assertTrue(service.replay === task, "the rotation started a second replay")
+        val writer = Thread {
+            java.io.FileOutputStream(fifo).use { out -> log.inputStream().use { it.copyTo(out) } }
+        }.apply { isDaemon = true; start() }
+        writer.join(60_000)
+        assertFalse(writer.isAlive, "nobody reads the replay's pipe")
+        task.join(120_000)
+        shadowOf(Looper.getMainLooper()).idle()
+        assertNull(service.replay, "the replay ended (and no other one was started)")
+        val status = controller.get().findViewById<TextView>(R.id.status_text).text.toString()
+        assertTrue(status.startsWith(app.getString(R.string.status_replay_done, fifo.name)),
+            "the re-created screen shows the replay's end: $status")
+        controller.destroy()
     }
 }

@@ -6,6 +6,8 @@ import android.content.pm.PackageManager
 import android.graphics.Bitmap
 import android.graphics.Point
 import android.graphics.Rect
+import android.location.GnssStatus
+import android.location.LocationManager
 import android.os.Looper
 import android.view.View
 import org.junit.Test
@@ -22,7 +24,14 @@ import org.pdnav.app.nav.NavOutput
 import org.pdnav.app.recording.ReplayTask
 import org.pdnav.app.recording.SessionStore
 import org.pdnav.app.ui.AppSettings
+import org.pdnav.app.nav.SampleBatch
+import org.pdnav.app.nav.SampleKind
+import org.pdnav.app.nav.SampleSink
+import org.pdnav.app.sensors.GnssSource
+import org.pdnav.app.sensors.SampleMerger
+import org.pdnav.app.sensors.SessionStats
 import org.pdnav.app.ui.MainActivity
+import org.pdnav.app.ui.SkyPlotView
 import org.pdnav.app.ui.SessionsActivity
 import org.pdnav.app.ui.SettingsActivity
 import org.robolectric.Robolectric
@@ -45,7 +54,8 @@ import kotlin.test.assertTrue
  * checks on the picture itself: where the estimate projects the marker's pixels are, the error
  * ellipse and the track are drawn where their points project, the basemap tiles (dem-tools,
  * Mapnik) are drawn under them, and no text is ellipsized, cut off or missing its glyphs.
- * Screens that do not exist yet (satellite view) get their picture when they exist.
+ * The satellite view is fed a synthetic GnssStatus through the app's own GnssStatus callback
+ * (the one that writes the `Status` lines), and its dots and C/N0 bars are checked pixel by pixel.
  */
 @RunWith(RobolectricTestRunner::class)
 @LooperMode(LooperMode.Mode.PAUSED)
@@ -225,5 +235,123 @@ class ScreensRoboTest {
         val pic = BasemapFixture.snapshot(decor)
         BasemapFixture.save(pic, "settings")
         BasemapFixture.assertTextNotClipped(decor, pic, "settings")
+    }
+
+    /** One satellite of the synthetic status: constellation, svid, C/N0, elevation, azimuth, used. */
+    private data class Sv(val c: Int, val svid: Int, val cn0: Float, val el: Float, val az: Float, val used: Boolean)
+
+    @Test
+    fun satelliteView() {
+        grantAll()
+        // GnssStatus -> the app's callback -> Status rows (merger) and the satellite list
+        val sv = listOf(
+            Sv(GnssStatus.CONSTELLATION_GPS, 5, 45f, 60f, 45f, true),
+            Sv(GnssStatus.CONSTELLATION_GALILEO, 11, 38f, 30f, 200f, true),
+            Sv(GnssStatus.CONSTELLATION_GLONASS, 7, 25f, 15f, 290f, false),
+            Sv(GnssStatus.CONSTELLATION_BEIDOU, 23, 30f, 75f, 120f, false),
+            Sv(GnssStatus.CONSTELLATION_GPS, 17, 41f, 40f, 330f, true),
+        )
+        val builder = GnssStatus.Builder()
+        for (s in sv) builder.addSatellite(s.c, s.svid, s.cn0, s.el, s.az, true, true, s.used, true, 1.57542e9f, false, 0f)
+        val rows = SampleBatch()
+        val merger = SampleMerger(0L, listOf(object : SampleSink {
+            override fun write(batch: SampleBatch) { for (i in 0 until batch.size) rows.addCopy(batch, i) }
+        }))
+        val gnss = GnssSource(app.getSystemService(LocationManager::class.java), merger,
+            elapsedNs = { 7_000_000_000L }, wallMs = { 1_780_000_000_000L })
+        gnss.statusCallback.onSatelliteStatusChanged(builder.build())
+        merger.flush(Long.MAX_VALUE, all = true)
+        assertEquals(sv.size, rows.size, "one Status row per satellite")
+        for ((i, s) in sv.withIndex()) {
+            assertEquals(SampleKind.GNSS_STATUS, rows.kind(i))
+            assertEquals(s.svid.toLong(), rows.long(i, 4)); assertEquals(if (s.used) 1L else 0L, rows.long(i, 5))
+            assertEquals(s.az.toDouble(), rows.double(i, 2), 1e-4); assertEquals(s.el.toDouble(), rows.double(i, 3), 1e-4)
+        }
+
+        val activity = Robolectric.buildActivity(MainActivity::class.java).setup().get()
+        activity.findViewById<View>(R.id.button_satellites).performClick()
+        activity.showStats(SessionStats(durationNs = 95_000_000_000L, recordingNs = 0L, navigating = true, recording = false,
+            fileName = "", fileBytes = 0L, rowsByKind = LongArray(SampleKind.COUNT), sensorRows = mapOf("accel" to 9500L),
+            gnssEpochs = 95L, fixes = 90L, lateRows = 0L, lastLate = null, magAccuracy = 0, satellites = gnss.satellites,
+            lastFix = null, locationEnabled = true, checkpoints = emptyList()))
+        idle()
+        val sky = activity.findViewById<SkyPlotView>(R.id.sky_plot)
+        assertEquals(View.VISIBLE, sky.visibility, "satellites button shows the sky plot")
+        val decor = activity.window.decorView
+        val pic = BasemapFixture.snapshot(decor)
+        BasemapFixture.save(pic, "satellites")
+        val loc = IntArray(2).also { sky.getLocationInWindow(it) }
+        val g = sky.plotGeometry()
+        assertTrue(g[2] > 50, "sky plot radius ${g[2]} px")
+        fun at(x: Float, y: Float) = pic.getPixel(loc[0] + x.toInt(), loc[1] + y.toInt())
+        // the projection, written out here (not the view's own function): north up, east right,
+        // zenith at the centre, horizon at radius r
+        fun project(azDeg: Double, elDeg: Double): FloatArray {
+            val rho = g[2] * (90.0 - elDeg) / 90.0
+            val a = Math.toRadians(azDeg)
+            return floatArrayOf((g[0] + rho * kotlin.math.sin(a)).toFloat(), (g[1] - rho * kotlin.math.cos(a)).toFloat())
+        }
+        for (s in sv) {
+            val col = SkyPlotView.constellationColor(s.c)
+            val p = project(s.az.toDouble(), s.el.toDouble())
+            val r = sky.dotRadius(s.cn0.toDouble())
+            val what = "svid ${s.svid} (az ${s.az}, el ${s.el}) at ${p[0]},${p[1]}"
+            if (s.used) {
+                assertTrue(BasemapFixture.close(at(p[0], p[1]), col, 24), "$what: used-in-fix dot is filled with its constellation colour")
+            } else {
+                assertTrue(!BasemapFixture.close(at(p[0], p[1]), col, 60), "$what: unused dot is a ring, not filled")
+                assertTrue(BasemapFixture.close(at(p[0] - r, p[1]), col, 40), "$what: ring drawn at radius $r px")
+            }
+            // the mirrored direction (azimuth + 180) stays empty: the dot is not drawn at -east/-north
+            val m = project(s.az + 180.0, s.el.toDouble())
+            assertTrue(!BasemapFixture.close(at(m[0], m[1]), col, 60), "$what: colour also at the mirrored ${m[0]},${m[1]}")
+        }
+        // C/N0 bars: one per satellite, height by C/N0, pale when not used; svid labels inside the view
+        val bars = sky.barOrder()
+        assertEquals(listOf(5, 17, 7, 23, 11), bars.map { it.svid }, "bars by constellation then svid")
+        val heights = ArrayList<Int>()
+        for ((k, s) in bars.withIndex()) {
+            val col = SkyPlotView.constellationColor(s.constellation)
+            val rect = sky.barRect(k, bars.size, s.cn0DbHz)
+            val what = "bar of svid ${s.svid} over $rect"
+            // the drawn bar, measured on the picture: from the bar's foot up while the colour holds
+            val foot = at(rect.centerX(), rect.bottom - 1)
+            var h = 0
+            while (h < sky.barStripPx && BasemapFixture.close(at(rect.centerX(), rect.bottom - 1 - h), foot, 6)) h++
+            heights += h
+            val inside = at(rect.centerX(), rect.bottom - 1 - h / 2)
+            val above = at(rect.centerX(), rect.bottom - 1 - h - 2)
+            assertTrue(h >= 10, "$what: $h px high")
+            assertTrue(!BasemapFixture.close(above, col, 40), "$what: colour continues above the bar")
+            if (s.usedInFix) {
+                assertTrue(BasemapFixture.close(inside, col, 24), "$what: used satellite bar in its colour")
+            } else {
+                val a = 110 / 255.0
+                val blend = android.graphics.Color.rgb(
+                    (android.graphics.Color.red(col) * a + android.graphics.Color.red(above) * (1 - a)).toInt(),
+                    (android.graphics.Color.green(col) * a + android.graphics.Color.green(above) * (1 - a)).toInt(),
+                    (android.graphics.Color.blue(col) * a + android.graphics.Color.blue(above) * (1 - a)).toInt())
+                assertTrue(BasemapFixture.close(inside, blend, 24), "$what: unused satellite bar pale")
+            }
+            val label = sky.labelBounds(k, bars.size, s.svid.toString())
+            assertTrue(label.left >= 0 && label.top >= 0 && label.right <= sky.width && label.bottom <= sky.height,
+                "label ${s.svid} at $label outside the ${sky.width}x${sky.height} view")
+            var ink = 0
+            for (y in label.top until label.bottom) for (x in label.left until label.right) {
+                val c = at(x.toFloat(), y.toFloat())
+                if (android.graphics.Color.red(c) < 128 && android.graphics.Color.green(c) < 128) ink++
+            }
+            assertTrue(ink >= 4, "label ${s.svid}: $ink dark pixels in $label")
+        }
+        // heights in proportion to C/N0 (the strongest signal is the tallest bar)
+        val hMax = heights.maxOrNull() ?: 0
+        val cMax = bars.maxOf { it.cn0DbHz }
+        for ((k, s) in bars.withIndex()) {
+            assertEquals(s.cn0DbHz / cMax, heights[k].toDouble() / hMax, 0.05, "bar height of svid ${s.svid}: $heights px for C/N0 ${bars.map { it.cn0DbHz }}")
+        }
+        val counters = activity.findViewById<android.widget.TextView>(R.id.counters_text)
+        assertTrue(counters.text.contains("3/5 satellites used"), "counters: ${counters.text}")
+        assertTrue(counters.text.contains("wave the phone"), "magnetometer unreliable is shown: ${counters.text}")
+        BasemapFixture.assertTextNotClipped(decor, pic, "satellite view")
     }
 }

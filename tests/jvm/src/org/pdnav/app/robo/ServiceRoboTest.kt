@@ -18,6 +18,7 @@ import org.junit.Before
 import org.junit.Test
 import org.junit.runner.RunWith
 import org.pdnav.app.nav.NativeLogReader
+import org.pdnav.app.nav.NavEstimate
 import org.pdnav.app.nav.NavOutput
 import org.pdnav.app.nav.NavigatorConfig
 import org.pdnav.app.nav.SampleBatch
@@ -27,6 +28,7 @@ import org.pdnav.app.recording.ReplayTask
 import org.pdnav.app.recording.SessionStore
 import org.pdnav.app.sensors.NavigationService
 import org.pdnav.app.sensors.NavigationSession
+import org.pdnav.app.sensors.SessionStats
 import org.robolectric.Robolectric
 import org.robolectric.RobolectricTestRunner
 import org.robolectric.RuntimeEnvironment
@@ -56,7 +58,8 @@ import kotlin.test.assertTrue
 class ServiceRoboTest {
     private val app = RuntimeEnvironment.getApplication()
     private val types = listOf(Sensor.TYPE_ACCELEROMETER, Sensor.TYPE_GYROSCOPE, Sensor.TYPE_MAGNETIC_FIELD,
-        Sensor.TYPE_ROTATION_VECTOR, Sensor.TYPE_PRESSURE, Sensor.TYPE_STEP_DETECTOR, Sensor.TYPE_GYROSCOPE_UNCALIBRATED)
+        Sensor.TYPE_ROTATION_VECTOR, Sensor.TYPE_PRESSURE, Sensor.TYPE_STEP_DETECTOR, Sensor.TYPE_GYROSCOPE_UNCALIBRATED,
+        Sensor.TYPE_GAME_ROTATION_VECTOR)
     private lateinit var sm: SensorManager
     private lateinit var lm: LocationManager
     private lateinit var sensors: Map<Int, Sensor>
@@ -100,6 +103,7 @@ class ServiceRoboTest {
         for (k in 0 until n) send(Sensor.TYPE_GYROSCOPE, t0 + k * 10_000_000L, floatArrayOf(0f, 0.01f * k, 0f))
         for (k in 0 until n step 2) send(Sensor.TYPE_MAGNETIC_FIELD, t0 + k * 10_000_000L, floatArrayOf(20f, -5f, -40f))
         for (k in 0 until n step 2) send(Sensor.TYPE_ROTATION_VECTOR, t0 + k * 10_000_000L, floatArrayOf(0f, 0f, 0.3826834f, 0.9238795f, 0.1f))
+        for (k in 0 until n step 4) send(Sensor.TYPE_GAME_ROTATION_VECTOR, t0 + k * 10_000_000L, floatArrayOf(0f, 0f, 0.5f, 0.8660254f))
         for (k in 0 until n step 10) send(Sensor.TYPE_PRESSURE, t0 + k * 10_000_000L, floatArrayOf(1013.25f))
         for (k in 0 until n step 10) send(Sensor.TYPE_GYROSCOPE_UNCALIBRATED, t0 + k * 10_000_000L, floatArrayOf(0f, 0.01f, 0f, 0.001f, 0.002f, 0.003f))
         send(Sensor.TYPE_STEP_DETECTOR, t0 + 550_000_000L, floatArrayOf(1f))
@@ -111,6 +115,21 @@ class ServiceRoboTest {
 
     private fun idleWorker(service: NavigationService) {
         service.workLooper?.let { shadowOf(it).idle() }
+        shadowOf(Looper.getMainLooper()).idle()
+    }
+
+    /**
+     * Like [idleWorker], but bounded: a worker thread that died (an Error escaping the session's
+     * handler) or is stuck makes the test fail after [seconds] instead of hanging it.
+     */
+    private fun idleWorkerBounded(service: NavigationService, seconds: Long = 20) {
+        service.workLooper?.let { l ->
+            val done = java.util.concurrent.CountDownLatch(1)
+            if (android.os.Handler(l).post { done.countDown() }) {
+                assertTrue(done.await(seconds, java.util.concurrent.TimeUnit.SECONDS),
+                    "worker thread did not come back within $seconds s (dead or stuck)")
+            }
+        }
         shadowOf(Looper.getMainLooper()).idle()
     }
 
@@ -154,6 +173,11 @@ class ServiceRoboTest {
         val status = GnssStatus.Builder().addSatellite(GnssStatus.CONSTELLATION_GPS, 7, 41f, 55f, 120f, true, true, true,
             true, 1.57542e9f, false, 0f).build()
         shadowOf(lm).simulateGnssStatus(status)
+        // the compass loses its calibration, then regains it (onAccuracyChanged has no timestamp:
+        // the row takes the callback's elapsed time)
+        session.sensors.onAccuracyChanged(sensors.getValue(Sensor.TYPE_MAGNETIC_FIELD), SensorManager.SENSOR_STATUS_UNRELIABLE)
+        assertEquals(SensorManager.SENSOR_STATUS_UNRELIABLE, session.stats().magAccuracy, "magnetometer accuracy on screen")
+        session.sensors.onAccuracyChanged(sensors.getValue(Sensor.TYPE_MAGNETIC_FIELD), SensorManager.SENSOR_STATUS_ACCURACY_HIGH)
         shadowOf(lm).simulateLocation(Location(LocationManager.GPS_PROVIDER).apply {
             latitude = 37.4; longitude = -122.08; accuracy = 4f; time = 1_700_000_000_000L
             elapsedRealtimeNanos = t0 + 500_000_000L
@@ -181,6 +205,7 @@ class ServiceRoboTest {
         val counts = mutableMapOf<Int, Int>()
         var lastT = Long.MIN_VALUE
         val svids = mutableListOf<Long>()
+        val accuracies = mutableListOf<Long>()
         val rows = readAll(file)
         for ((kind, t, b) in rows) {
             if (kind != SampleKind.META) {
@@ -192,6 +217,13 @@ class ServiceRoboTest {
                 svids += b.long(0, 5)
                 assertEquals(30.0 + b.long(0, 5), b.double(0, 6), "Cn0 of svid ${b.long(0, 5)}")
             }
+            if (kind == SampleKind.SENSOR_ACCURACY) {
+                assertEquals(Sensor.TYPE_MAGNETIC_FIELD.toLong(), b.long(0, 1))
+                accuracies += b.long(0, 2)
+            }
+            if (kind == SampleKind.GAME_ROTATION_VECTOR) {
+                assertEquals(0.5, b.double(0, 2), 1e-6); assertEquals(0.8660254, b.double(0, 3), 1e-6)
+            }
             if (kind == SampleKind.GNSS_STATUS) {
                 assertEquals(7L, b.long(0, 4)); assertEquals(1L, b.long(0, 5)); assertEquals(55.0, b.double(0, 3), 1e-4)
             }
@@ -200,6 +232,8 @@ class ServiceRoboTest {
         assertEquals(50, counts[SampleKind.MAG]); assertEquals(50, counts[SampleKind.ROTATION_VECTOR])
         assertEquals(10, counts[SampleKind.PRESSURE]); assertEquals(1, counts[SampleKind.STEP_DETECTOR])
         assertEquals(10, counts[SampleKind.UNCAL_GYRO], "uncalibrated gyroscope recorded")
+        assertEquals(25, counts[SampleKind.GAME_ROTATION_VECTOR], "game rotation vector recorded")
+        assertEquals(listOf(0L, 3L), accuracies, "magnetometer accuracy changes recorded in order")
         assertEquals(1, counts[SampleKind.GNSS_STATUS], "Status line per satellite")
         assertEquals(listOf(3L, 7L, 12L, 3L, 7L), svids)
         assertEquals(1, counts[SampleKind.FIX])
@@ -246,8 +280,8 @@ class ServiceRoboTest {
             injectSecond(SystemClock.elapsedRealtimeNanos())
             ShadowSystemClock.advanceBy(Duration.ofSeconds(3))
             service.workLooper?.let { l -> android.os.Handler(l).post { session.pump() } }
-            idleWorker(service)
-            idleWorker(service)
+            idleWorkerBounded(service)
+            idleWorkerBounded(service)
             assertTrue(calls >= 1, "the sink was called")
             val why = assertNotNull(service.lastError, "error reported for $failure")
             assertTrue(why.contains(if (failure is IOException) "No space left" else "native library"), why)
@@ -262,6 +296,46 @@ class ServiceRoboTest {
             assertTrue(meta.any { it.first == NavigationSession.KEY_END && it.second.startsWith("error") }, "end marker says error: $meta")
             controller.destroy()
         }
+    }
+
+    @Test
+    fun theNotificationShowsDurationSizeAndCountsPerLineType() {
+        val service = Robolectric.buildService(NavigationService::class.java).create().get()
+        val byKind = LongArray(SampleKind.COUNT).also {
+            it[SampleKind.ACCEL] = 9500; it[SampleKind.GNSS_RAW] = 340; it[SampleKind.SENSOR_ACCURACY] = 2
+        }
+        val stats = SessionStats(durationNs = 100_000_000_000L, recordingNs = 3_725_000_000_000L, navigating = true,
+            recording = true, fileName = "s.txt", fileBytes = 1_234_567L, rowsByKind = byKind, sensorRows = emptyMap(),
+            gnssEpochs = 34L, fixes = 30L, lateRows = 0L, lastLate = null, magAccuracy = 3, satellites = emptyList(),
+            lastFix = null, locationEnabled = true, checkpoints = emptyList())
+        val text = service.stateText(stats)
+        for (part in listOf("REC 01:02:05", "1.2 MB", "9842 lines", "Accel 9500", "Raw 340", "SensorAccuracy 2")) {
+            assertTrue(part in text, "notification text has \"$part\": $text")
+        }
+        val n = service.buildNotification(text)
+        assertEquals(text, n.extras.getCharSequence(android.app.Notification.EXTRA_BIG_TEXT)?.toString(), "expanded text")
+        assertNotNull(n.actions?.firstOrNull { it.title.toString() == app.getString(org.pdnav.app.R.string.action_stop) }, "Stop action")
+        // not recording: the duration only, no counts
+        val idle = service.stateText(stats.copy(recording = false, navigating = false))
+        assertEquals("00:01:40", idle)
+    }
+
+    @Test
+    fun theTrackKeepsBoundedMemoryTheStartAndTheRecentPart() {
+        val service = Robolectric.buildService(NavigationService::class.java).create().get()
+        val n = 3 * NavigationService.TRACK_MAX
+        for (k in 0 until n) {
+            val e = NavEstimate(k * 1_000_000_000L, 1, 1, "", 42.5 + k * 1e-6, 1.5, 1500.0, 0.0, 0.0, 4.0, 0.0, 4.0, 3.0)
+            service.publish(NavOutput(e, arrayOf(e), k.toLong(), DoubleArray(0)))
+        }
+        val track = service.track
+        assertTrue(track.size <= NavigationService.TRACK_MAX, "track holds ${track.size} points after $n outputs")
+        assertTrue(track.size >= NavigationService.TRACK_MAX / 2, "track thinned to ${track.size} points")
+        assertEquals(42.5, track.first()[0], 1e-12, "the start is kept")
+        assertEquals(42.5 + (n - 1) * 1e-6, track.last()[0], 1e-12, "the newest point is kept")
+        // the recent part stays dense: the last 100 outputs are all there, in order
+        for (j in 1..100) assertEquals(42.5 + (n - j) * 1e-6, track[track.size - j][0], 1e-12, "recent point $j")
+        for (i in 1 until track.size) assertTrue(track[i][0] > track[i - 1][0], "track in time order at $i")
     }
 
     @Test

@@ -118,6 +118,24 @@ class SampleBatch(initialCapacity: Int = 256) {
         setDouble(r, 4, headingAccuracyRad)
     }
 
+    /** Game rotation vector: unit quaternion phone->(Z up, arbitrary yaw) frame, no magnetometer. */
+    fun addGameRotationVector(t: Long, x: Double, y: Double, z: Double, w: Double, utcMs: Long = MISSING) {
+        val r = addRow(SampleKind.GAME_ROTATION_VECTOR, t)
+        setLong(r, 0, utcMs)
+        setDouble(r, 0, x); setDouble(r, 1, y); setDouble(r, 2, z); setDouble(r, 3, w)
+    }
+
+    /**
+     * onAccuracyChanged: Android sensor type and SENSOR_STATUS_* (-1 no contact .. 3 high);
+     * the log reader rejects other values, so they are refused here already.
+     */
+    fun addSensorAccuracy(t: Long, sensorType: Int, accuracy: Int, utcMs: Long = MISSING) {
+        require(sensorType > 0) { "sensor type $sensorType is not an Android sensor type" }
+        require(accuracy in -1..3) { "accuracy $accuracy is not a SENSOR_STATUS (-1..3)" }
+        val r = addRow(SampleKind.SENSOR_ACCURACY, t)
+        setLong(r, 0, utcMs); setLong(r, 1, sensorType.toLong()); setLong(r, 2, accuracy.toLong())
+    }
+
     fun addStep(t: Long, utcMs: Long = MISSING) {
         val r = addRow(SampleKind.STEP_DETECTOR, t)
         setLong(r, 0, utcMs)

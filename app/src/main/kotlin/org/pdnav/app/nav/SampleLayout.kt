@@ -42,5 +42,7 @@ object SampleKind {
     const val AGC = 15
     const val TRUTH = 16
     const val META = 17
-    const val COUNT = 18
+    const val GAME_ROTATION_VECTOR = 18
+    const val SENSOR_ACCURACY = 19
+    const val COUNT = 20
 }

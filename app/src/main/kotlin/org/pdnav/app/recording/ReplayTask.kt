@@ -43,6 +43,9 @@ class ReplayTask(
         cancelled = true
     }
 
+    /** True once [cancel] was called (a rotation must not do that). */
+    val isCancelled: Boolean get() = cancelled
+
     /** Waits for the replay to end (tests). */
     fun join(timeoutMs: Long) {
         thread?.join(timeoutMs)

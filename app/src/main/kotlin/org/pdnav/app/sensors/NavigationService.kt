@@ -70,6 +70,11 @@ class NavigationService : Service() {
     var replayPath: String? = null
         private set
 
+    /** The latest replay report, so a screen re-created by a rotation shows it at once. */
+    data class ReplayState(val output: NavOutput?, val fraction: Double, val done: Boolean, val error: String?)
+    var replayState: ReplayState? = null
+        private set
+
     /** Test seam: extra sinks every new session feeds (e.g. one that throws, like a full disk). */
     var testSinks: List<SampleSink> = emptyList()
 
@@ -170,6 +175,7 @@ class NavigationService : Service() {
     fun startSession(navigate: Boolean, record: Boolean, declaredStart: DoubleArray? = null): NavigationSession? {
         session?.let { return it }
         lastError = null
+        replayState = null
         return try {
             goForeground()
             acquireWakeLock()
@@ -282,17 +288,25 @@ class NavigationService : Service() {
         replay?.cancel()
         val settings = AppSettings(getSharedPreferences(AppSettings.PREFS, Context.MODE_PRIVATE))
         val task = ReplayTask(path, settings.navigatorConfig(), REPLAY_SEED,
-            onProgress = { out, frac -> mainHandler.post { listeners.toList().forEach { it.onReplay(out, frac, false, null) } } },
+            onProgress = { out, frac ->
+                mainHandler.post {
+                    replayState = ReplayState(out, frac, false, null)
+                    listeners.toList().forEach { it.onReplay(out, frac, false, null) }
+                }
+            },
             onDone = { out, err ->
                 mainHandler.post {
                     replay = null
-                    listeners.toList().forEach { it.onReplay(out, 1.0, true, err?.let { e -> NavigationSession.describe(e) }) }
+                    val why = err?.let { e -> NavigationSession.describe(e) }
+                    replayState = ReplayState(out, 1.0, true, why)
+                    listeners.toList().forEach { it.onReplay(out, 1.0, true, why) }
                     stateChanged()
                     if (session == null) stopSelf()
                 }
             })
         replay = task
         replayPath = path
+        replayState = ReplayState(null, 0.0, false, null)
         interrupted = null
         task.start()
         stateChanged()
@@ -312,7 +326,8 @@ class NavigationService : Service() {
 
     // ---- outputs -------------------------------------------------------------------------------
 
-    private fun publish(out: NavOutput) {
+    /** Internal (not private) so the host test can drive the track past [TRACK_MAX]. */
+    internal fun publish(out: NavOutput) {
         lastOutput = out
         val e = out.estimate
         if (e.valid && !e.latDeg.isNaN()) {
@@ -356,7 +371,9 @@ class NavigationService : Service() {
         if (stats == null) return getString(R.string.notification_text)
         if (stats.navigating) parts += getString(R.string.state_navigating)
         parts += if (stats.recording) stats.recordingLine() else SessionStats.hms(stats.durationNs)
-        return parts.joinToString(" · ")
+        val head = parts.joinToString(" · ")
+        // the counts per line type on a second line (the expanded notification shows it)
+        return if (stats.recording && stats.rowsByKind.any { it > 0 }) head + "\n" + stats.countsLine() else head
     }
 
     private fun sessionMeta(s: AppSettings): List<Pair<String, String>> {
@@ -422,6 +439,7 @@ class NavigationService : Service() {
         }
         return builder(CHANNEL).setContentTitle(getString(R.string.app_name))
             .setContentText(text)
+            .setStyle(Notification.BigTextStyle().bigText(text))
             .setSmallIcon(R.drawable.ic_launcher)
             .setContentIntent(open)
             .setOngoing(true)

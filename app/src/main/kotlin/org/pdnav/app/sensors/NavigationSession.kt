@@ -341,6 +341,7 @@ class NavigationSession(
             SampleKind.STEP_COUNTER -> "StepCounter"; SampleKind.GNSS_RAW -> "Raw"; SampleKind.FIX -> "Fix"
             SampleKind.NAV_MESSAGE -> "Nav"; SampleKind.GNSS_STATUS -> "Status"; SampleKind.AGC -> "Agc"
             SampleKind.TRUTH -> "Truth"; SampleKind.META -> "Meta"
+            SampleKind.GAME_ROTATION_VECTOR -> "GameRotationVector"; SampleKind.SENSOR_ACCURACY -> "SensorAccuracy"
             else -> "kind $kind"
         }
     }

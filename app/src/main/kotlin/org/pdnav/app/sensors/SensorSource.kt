@@ -6,6 +6,7 @@ import android.hardware.SensorEventListener
 import android.hardware.SensorManager
 import android.os.Build
 import android.os.Handler
+import android.os.SystemClock
 import org.pdnav.app.nav.SampleBatch
 import org.pdnav.app.nav.SampleKind
 import kotlin.math.sqrt
@@ -23,6 +24,8 @@ import kotlin.math.sqrt
 class SensorSource(
     private val sensors: SensorManager,
     private val merger: SampleMerger,
+    /** Clock of onAccuracyChanged rows (the callback has no timestamp): elapsedRealtimeNanos, UTC ms. */
+    private val clock: () -> Pair<Long, Long> = { SystemClock.elapsedRealtimeNanos() to System.currentTimeMillis() },
     private val onEvent: () -> Unit = {},
 ) : SensorEventListener {
 
@@ -85,9 +88,25 @@ class SensorSource(
         onEvent()
     }
 
+    /**
+     * Records a `SensorAccuracy` line (docs/log-format.md) for every accuracy report of a
+     * subscribed sensor: the magnetometer's says when the heading can be trusted (a user waves
+     * the phone at "unreliable"), and replay can tell which stretches had a calibrated compass.
+     */
     override fun onAccuracyChanged(sensor: Sensor, accuracy: Int) {
-        if (sensor.type == Sensor.TYPE_MAGNETIC_FIELD) magAccuracy = accuracy
+        val type = sensor.type
+        if (type == Sensor.TYPE_MAGNETIC_FIELD) magAccuracy = accuracy
+        if (type <= 0 || accuracy !in -1..3) return  // not a SENSOR_STATUS: nothing the log can hold
+        val (t, utc) = clock()
+        merger.add { b -> b.addSensorAccuracy(t, type, accuracy, utc) }
+        accuracyReports.merge(type, 1L, Long::plus)
+        onEvent()
     }
+
+    private val accuracyReports = java.util.concurrent.ConcurrentHashMap<Int, Long>()
+
+    /** onAccuracyChanged reports recorded so far per sensor type. */
+    fun accuracyReportsByType(): Map<Int, Long> = HashMap(accuracyReports)
 
     companion object {
         /** Batching: up to 100 ms of samples per delivery (saves power, keeps latency low). */
@@ -99,6 +118,8 @@ class SensorSource(
             Rate(Sensor.TYPE_GYROSCOPE, 10_000, LATENCY_US),
             Rate(Sensor.TYPE_MAGNETIC_FIELD, 20_000, LATENCY_US),
             Rate(Sensor.TYPE_ROTATION_VECTOR, 20_000, LATENCY_US),
+            // gyro + accelerometer only: an attitude that magnetic disturbances do not bend
+            Rate(Sensor.TYPE_GAME_ROTATION_VECTOR, 20_000, LATENCY_US),
             Rate(Sensor.TYPE_PRESSURE, 100_000, LATENCY_US),
             Rate(Sensor.TYPE_STEP_DETECTOR, 0, 0),
             // GnssLogger's UncalAccel / UncalGyro / UncalMag (bias estimates kept beside the values)
@@ -113,6 +134,7 @@ class SensorSource(
             Sensor.TYPE_GYROSCOPE -> "gyro"
             Sensor.TYPE_MAGNETIC_FIELD -> "mag"
             Sensor.TYPE_ROTATION_VECTOR -> "rotation"
+            Sensor.TYPE_GAME_ROTATION_VECTOR -> "game rotation"
             Sensor.TYPE_PRESSURE -> "baro"
             Sensor.TYPE_STEP_DETECTOR -> "steps"
             Sensor.TYPE_ACCELEROMETER_UNCALIBRATED -> "uncal accel"
@@ -129,6 +151,10 @@ class SensorSource(
                 Sensor.TYPE_MAGNETIC_FIELD -> if (v.size >= 3) b.addVector(SampleKind.MAG, t, v[0].toDouble(), v[1].toDouble(), v[2].toDouble())
                 Sensor.TYPE_PRESSURE -> if (v.isNotEmpty()) b.addPressure(t, v[0] * 100.0)  // hPa -> Pa
                 Sensor.TYPE_ROTATION_VECTOR -> if (v.size >= 3) addRotation(b, t, v)
+                Sensor.TYPE_GAME_ROTATION_VECTOR -> if (v.size >= 3) {
+                    val q = quaternion(v)
+                    b.addGameRotationVector(t, q[0], q[1], q[2], q[3])
+                }
                 Sensor.TYPE_STEP_DETECTOR -> b.addStep(t)
                 Sensor.TYPE_ACCELEROMETER_UNCALIBRATED -> addUncal(b, SampleKind.UNCAL_ACCEL, t, v)
                 Sensor.TYPE_GYROSCOPE_UNCALIBRATED -> addUncal(b, SampleKind.UNCAL_GYRO, t, v)
@@ -144,15 +170,20 @@ class SensorSource(
             b.addUncalibrated(kind, t, value, bias)
         }
 
-        private fun addRotation(b: SampleBatch, t: Long, v: FloatArray) {
+        /** x, y, z, w of a rotation-vector event; values[3] (w) is optional on old devices: from the unit norm. */
+        private fun quaternion(v: FloatArray): DoubleArray {
             val x = v[0].toDouble()
             val y = v[1].toDouble()
             val z = v[2].toDouble()
-            // values[3] (w) is optional on old devices: recover it from the unit norm.
             val w = if (v.size >= 4) v[3].toDouble() else sqrt((1.0 - x * x - y * y - z * z).coerceAtLeast(0.0))
+            return doubleArrayOf(x, y, z, w)
+        }
+
+        private fun addRotation(b: SampleBatch, t: Long, v: FloatArray) {
+            val q = quaternion(v)
             // values[4]: estimated heading accuracy (rad), -1 when unavailable.
             val acc = if (v.size >= 5 && v[4] >= 0f) v[4].toDouble() else Double.NaN
-            b.addRotationVector(t, x, y, z, w, acc)
+            b.addRotationVector(t, q[0], q[1], q[2], q[3], acc)
         }
     }
 }

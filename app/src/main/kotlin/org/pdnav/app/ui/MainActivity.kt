@@ -99,6 +99,7 @@ class MainActivity : Activity() {
             s.lastOutput?.let { showOutput(it, s.track) }
             s.lastStats?.let { showStats(it) }
             s.lastError?.let { status.text = getString(R.string.status_error, it) }
+            s.replayState?.let { listener.onReplay(it.output, it.fraction, it.done, it.error) }  // e.g. after a rotation
             pendingReplay?.let {
                 pendingReplay = null
                 startReplay(it)
@@ -417,6 +418,18 @@ class MainActivity : Activity() {
 
     // ---- layout -------------------------------------------------------------------------------
 
+    /** An empty line of the top panel takes no room (an empty TextView is still a line high). */
+    private fun hideWhenEmpty(v: TextView) {
+        v.visibility = View.GONE
+        v.addTextChangedListener(object : android.text.TextWatcher {
+            override fun beforeTextChanged(s: CharSequence?, start: Int, count: Int, after: Int) = Unit
+            override fun onTextChanged(s: CharSequence?, start: Int, before: Int, count: Int) = Unit
+            override fun afterTextChanged(s: android.text.Editable?) {
+                v.visibility = if (s.isNullOrEmpty()) View.GONE else View.VISIBLE
+            }
+        })
+    }
+
     private fun buildLayout(): View {
         val root = FrameLayout(this)
         val map = MapView(this).apply { id = R.id.map_view }
@@ -425,8 +438,8 @@ class MainActivity : Activity() {
 
         val pad = Views.dp(this, 8)
         status = TextView(this).apply { id = R.id.status_text }
-        info = TextView(this).apply { id = R.id.info_text }
-        counters = TextView(this).apply { id = R.id.counters_text; textSize = 11f }
+        info = TextView(this).apply { id = R.id.info_text; hideWhenEmpty(this) }
+        counters = TextView(this).apply { id = R.id.counters_text; textSize = 11f; hideWhenEmpty(this) }
         skyPlot = SkyPlotView(this).apply { id = R.id.sky_plot; visibility = View.GONE }
         locationPanel = LinearLayout(this).apply {
             id = R.id.location_panel
@@ -456,7 +469,7 @@ class MainActivity : Activity() {
             addView(counters)
             addView(locationPanel)
             addView(interruptedPanel)
-            addView(skyPlot, LinearLayout.LayoutParams(-1, Views.dp(context, 200)))
+            addView(skyPlot, LinearLayout.LayoutParams(-1, Views.dp(context, 264)))
         }
         root.addView(top, FrameLayout.LayoutParams(-1, -2, Gravity.TOP))
 
