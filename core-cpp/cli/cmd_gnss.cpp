@@ -39,15 +39,12 @@ struct GnssArgs {
   std::uint64_t seed = 1;
   int keep_every = 1;  // robustness check: keep every N-th epoch (duty cycling)
   bool clock_steps = false;  // robustness check: a 1 ms code-only clock step every epoch
-<<<<<<< HEAD
   bool hw_discontinuities = false;  // robustness check: HardwareClockDiscontinuityCount changes every epoch
-=======
   double iono_window_s = gnss::SmoothingOptions{}.iono_window_s;
   int dual_min_sats = gnss::MeasurementOptions{}.dual_min_sats;
   double dual_min_fraction = gnss::MeasurementOptions{}.dual_min_fraction;
   bool dual_keep_single = gnss::MeasurementOptions{}.dual_keep_single;
   std::string freq = gnss::MeasurementOptions{}.frequency == gnss::FrequencyMode::kDual ? "dual" : "single";
->>>>>>> wt/gnssb
   double kf_displacement_q_m2 = gnss::KalmanOptions{}.displacement_q_m2;
   double kf_fix_scale = gnss::KalmanOptions{}.fix_variance_scale;
   std::string dynamics = gnss::kf_dynamics_name(gnss::KalmanOptions{}.dynamics);
