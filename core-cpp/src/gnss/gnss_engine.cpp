@@ -81,30 +81,42 @@ struct GnssEngine::Impl {
     return default_carrier_hz(m.sat.sys, ch);
   }
 
-  void handle_clock_jump(const MeasurementEpoch& ep) {
-    if (prev_hw_disc != kMissingInt && ep.hw_discontinuity != kMissingInt && ep.hw_discontinuity != prev_hw_disc) {
+  /// True when the receiver clock had a hardware discontinuity since the previous epoch.
+  bool handle_clock_jump(const MeasurementEpoch& ep) {
+    const bool jump =
+        prev_hw_disc != kMissingInt && ep.hw_discontinuity != kMissingInt && ep.hw_discontinuity != prev_hw_disc;
+    if (jump) {
       count("clock: hardware clock discontinuity (TDCP and KF clock reset)");
       has_prev = false;
       kf.reset_clock(0.0, 1e12);
     }
     prev_hw_disc = ep.hw_discontinuity;
+    return jump;
   }
 
   void process(const std::vector<GnssRawSample>& rows) {
     ++epochs;
     MeasurementEpoch ep;
     if (!build_epoch(rows, opt.measurements, ep, excluded)) { count("epoch: no usable measurement"); return; }
-    handle_clock_jump(ep);
+    const bool had_prev = has_prev;
+    const bool clock_break = handle_clock_jump(ep);
     std::int64_t d_rx_ns = 0, d_full_bias_ns = 0;  // exact int64 differences; overflow = no link
-    const bool linked = has_prev && !__builtin_sub_overflow(ep.rx.ns, prev_rx.ns, &d_rx_ns) &&
-                        !__builtin_sub_overflow(ep.full_bias_nanos, prev_full_bias_nanos, &d_full_bias_ns);
+    const bool rx_linked = had_prev && !__builtin_sub_overflow(ep.rx.ns, prev_rx.ns, &d_rx_ns);
+    const bool linked = has_prev && rx_linked && !__builtin_sub_overflow(ep.full_bias_nanos, prev_full_bias_nanos, &d_full_bias_ns);
     const double dt = linked ? static_cast<double>(d_rx_ns) * 1e-9 : 0.0;
+    // Across a hardware clock discontinuity the GPS receive time stays continuous (FullBiasNanos
+    // follows the re-set clock), so the code smoother keeps its satellites and propagates them by
+    // Doppler, which does not see the receiver clock; the common-step removal takes the code jump.
+    const double dt_rx = rx_linked ? static_cast<double>(d_rx_ns) * 1e-9 : 0.0;
+    const bool smooth_through_break =
+        clock_break && opt.smoothing.doppler_through_clock_breaks && dt_rx > 0.0 && dt_rx <= opt.max_epoch_gap_s;
     if (has_prev && (!linked || !(dt > 0.0) || dt > opt.max_epoch_gap_s)) {
       count("epoch: gap or time going backwards (no TDCP)");
       has_prev = false;
     }
     const double d_bias_ns = has_prev ? static_cast<double>(d_full_bias_ns) + (ep.bias_nanos - prev_bias_nanos) : 0.0;
-    smoother.begin_epoch(has_prev ? dt : 0.0, d_bias_ns * 1e-9 * kSpeedOfLight_mps);
+    if (smooth_through_break) smoother.begin_epoch(dt_rx, 0.0, /*carrier_broken=*/true);
+    else smoother.begin_epoch(has_prev ? dt : 0.0, d_bias_ns * 1e-9 * kSpeedOfLight_mps);
     std::vector<SppObservation> spp_obs;
     std::vector<CarrierObservation> car_obs;
     std::vector<SmoothingInput> sm_in;

@@ -5,9 +5,10 @@
 
 namespace pdnav::gnss {
 
-void CodeSmoother::begin_epoch(double dt_s, double clock_jump_m) {
+void CodeSmoother::begin_epoch(double dt_s, double clock_jump_m, bool carrier_broken) {
   ++epoch_;
   dt_s_ = dt_s;
+  carrier_broken_ = carrier_broken;
   clock_jump_m_ = std::isfinite(clock_jump_m) ? clock_jump_m : 0.0;
   if (!(dt_s > 0.0)) sats_.clear();
 }
@@ -19,7 +20,7 @@ double CodeSmoother::innovation(const SmoothingInput& in) const {
   const Sat& s = it->second;
   if (!(s.epoch == epoch_ - 1 && dt_s_ > 0.0 && opt_.window_s > 0.0 && s.iono_free == in.iono_free)) return std::nan("");
   double delta = std::nan("");
-  if (std::isfinite(in.adr_m) && std::isfinite(s.adr_m)) delta = in.adr_m - s.adr_m - clock_jump_m_;
+  if (!carrier_broken_ && std::isfinite(in.adr_m) && std::isfinite(s.adr_m)) delta = in.adr_m - s.adr_m - clock_jump_m_;
   else if (std::isfinite(in.pr_rate_mps) && std::isfinite(s.pr_rate_mps))
     delta = 0.5 * (in.pr_rate_mps + s.pr_rate_mps) * dt_s_ - clock_jump_m_;
   return in.pseudorange_m - (s.pr_sm_m + delta);
@@ -79,7 +80,7 @@ double CodeSmoother::smooth(const SmoothingInput& in, std::string* reason) {
   if (s.epoch == epoch_ - 1 && s.iono_free != in.iono_free && reason != nullptr)
     *reason = "smoothing: single/dual frequency switch (restarted)";
   double delta = std::nan("");
-  if (continuous && std::isfinite(in.adr_m) && std::isfinite(s.adr_m)) {
+  if (continuous && !carrier_broken_ && std::isfinite(in.adr_m) && std::isfinite(s.adr_m)) {
     delta = in.adr_m - s.adr_m - clock_jump_m_;
   } else if (continuous && std::isfinite(in.pr_rate_mps) && std::isfinite(s.pr_rate_mps)) {
     delta = 0.5 * (in.pr_rate_mps + s.pr_rate_mps) * dt_s_ - clock_jump_m_;
@@ -96,7 +97,7 @@ double CodeSmoother::smooth(const SmoothingInput& in, std::string* reason) {
     s.n = 1.0;
     s.pr_sm_m = in.pseudorange_m;
   }
-  s.adr_m = in.adr_m;
+  s.adr_m = carrier_broken_ ? std::nan("") : in.adr_m;  // the carrier restarts at a clock break
   s.pr_rate_mps = in.pr_rate_mps;
   s.epoch = epoch_;
   s.iono_free = in.iono_free;

@@ -21,6 +21,7 @@ struct SmoothingOptions {
   /// clock discontinuity) is common to all satellites; a slip or multipath is not.
   bool remove_common_step = true;
   int min_sats_common_step = 4;     // fewer continuous satellites: no common-step estimate
+  bool doppler_through_clock_breaks = true;  // keep smoothing by Doppler across a hardware clock discontinuity
   /// Averaging window of the dual-frequency ionosphere correction (s); 0 = the raw IF code.
   /// The L1 ionosphere changes by < 0.1 m per minute outside storms (Klobuchar's diurnal cosine
   /// at 10-50 m peak-to-peak vertical L1 delay over ~12 h), measured effect in docs/gnss.md.
@@ -50,8 +51,10 @@ class CodeSmoother {
   explicit CodeSmoother(SmoothingOptions opt = {}) : opt_(opt) {}
   /// Starts a new epoch `dt_s` after the previous one; `clock_jump_m` = c * change of
   /// (FullBiasNanos + BiasNanos), which moves the code but not the carrier. A non-positive
-  /// dt_s (gap, clock discontinuity) restarts every satellite.
-  void begin_epoch(double dt_s, double clock_jump_m);
+  /// dt_s (gap) restarts every satellite. `carrier_broken` (a hardware clock discontinuity:
+  /// carrier phase lost, code re-clocked) keeps the satellites but propagates them by Doppler
+  /// only; the code's jump is then taken by the common-step removal (pass clock_jump_m = 0).
+  void begin_epoch(double dt_s, double clock_jump_m, bool carrier_broken = false);
   /// Smoothed pseudorange of one satellite at this epoch; `reason` is set when it restarted
   /// for a reason worth counting ("code-carrier jump").
   double smooth(const SmoothingInput& in, std::string* reason = nullptr);
@@ -76,6 +79,7 @@ class CodeSmoother {
   std::int64_t epoch_ = 0;
   double dt_s_ = 0.0;
   double clock_jump_m_ = 0.0;
+  bool carrier_broken_ = false;
   double common_step_m_ = 0.0;
   /// code - propagated for a continuous satellite, NaN otherwise
   double innovation(const SmoothingInput& in) const;
