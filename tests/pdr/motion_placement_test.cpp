@@ -312,3 +312,58 @@ TEST(PdrPlacement, FirstStepsOfAReversedPhoneAreReprojectedOnceTheDirectionIsKno
   for (std::size_t i = 0; i < ref.size(); ++i)
     EXPECT_LT(std::abs(wrap_pi(ref_no_wait[i].heading_rad - ref[i].heading_rad)), 1e-9) << i;
 }
+
+TEST(PdrHeading, UnreliableMagnetometerAccuracyKeepsADisturbedRotationVectorFromDraggingTheHeading) {
+  // The real walk's rotation vector turned 50 deg from mid-walk on (a compass that lost its
+  // calibration): with no accuracy event the heading follows it; after Android reports the
+  // magnetometer as unreliable (accuracy 0) the gyro keeps the heading.
+  const RealWalk walk = read_ilc(pdnav::test::shared_data(kWalk));
+  ASSERT_GT(walk.rotation.size(), 100u);
+  const TimeNs t_mid = walk.accel[walk.accel.size() / 2].t_ns;
+  RealWalk turned = walk;
+  const Eigen::Quaterniond yaw(Eigen::AngleAxisd(50 * kDegToRad, Eigen::Vector3d::UnitZ()));
+  for (auto& r : turned.rotation) {
+    if (r.t_ns < t_mid) continue;
+    const Eigen::Quaterniond q(r.quat_xyzw[3], r.quat_xyzw[0], r.quat_xyzw[1], r.quat_xyzw[2]);
+    const Eigen::Quaterniond qt = yaw * q;
+    r.quat_xyzw = Eigen::Vector4d(qt.x(), qt.y(), qt.z(), qt.w());
+  }
+  auto steps_after = [&](const RealWalk& w, bool unreliable) {
+    Pdr p{PdrOptions{}};
+    std::vector<PdrStep> out;
+    std::size_t ig = 0, ir = 0;
+    bool sent = false;
+    for (const auto& s : w.accel) {
+      if (unreliable && !sent && s.t_ns >= t_mid) {
+        p.feed(SensorAccuracySample{s.t_ns, kMissingInt, 2, 0});
+        sent = true;
+      }
+      while (ig < w.gyro.size() && w.gyro[ig].t_ns <= s.t_ns) p.feed(w.gyro[ig++]);
+      while (ir < w.rotation.size() && w.rotation[ir].t_ns <= s.t_ns) p.feed(w.rotation[ir++]);
+      p.feed(s);
+      for (const auto& st : p.take_steps()) out.push_back(st);
+    }
+    return out;
+  };
+  const auto ref = steps_after(walk, false);
+  const auto dragged = steps_after(turned, false);
+  const auto kept = steps_after(turned, true);
+  ASSERT_EQ(ref.size(), dragged.size());
+  ASSERT_EQ(ref.size(), kept.size());
+  double dragged_deg = 0, kept_deg = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    if (ref[i].t_ns < t_mid + 5'000'000'000LL) continue;  // 5 s after the disturbance starts
+    dragged_deg += std::abs(wrap_pi(dragged[i].heading_rad - ref[i].heading_rad)) / kDegToRad;
+    kept_deg += std::abs(wrap_pi(kept[i].heading_rad - ref[i].heading_rad)) / kDegToRad;
+    ++n;
+  }
+  ASSERT_GT(n, 5);
+  dragged_deg /= n;
+  kept_deg /= n;
+  EXPECT_GT(dragged_deg, 15.0) << "a trusted rotation vector pulls the heading";
+  EXPECT_LT(kept_deg, 0.4 * dragged_deg) << "dragged " << dragged_deg << " deg, kept " << kept_deg << " deg";
+  HeadingFusion h;
+  EXPECT_DOUBLE_EQ(h.accuracy_weight(3), 1.0);
+  EXPECT_DOUBLE_EQ(h.accuracy_weight(-1), h.accuracy_weight(0));
+}

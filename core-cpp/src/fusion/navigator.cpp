@@ -355,7 +355,8 @@ struct Navigator::Impl {
         [&](const auto& x) {
           using T = std::decay_t<decltype(x)>;
           if constexpr (std::is_same_v<T, AccelSample> || std::is_same_v<T, GyroSample> || std::is_same_v<T, MagSample> ||
-                        std::is_same_v<T, RotationVectorSample> || std::is_same_v<T, StepDetectorSample>) {
+                        std::is_same_v<T, RotationVectorSample> || std::is_same_v<T, StepDetectorSample> ||
+                        std::is_same_v<T, SensorAccuracySample>) {
             pdr.feed(x);
             drain_pdr();
           } else if constexpr (std::is_same_v<T, PressureSample>) {

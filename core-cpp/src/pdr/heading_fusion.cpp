@@ -15,6 +15,10 @@ void HeadingFusion::set_reference_field(double total_ut, double inclination_rad)
   }
 }
 
+double HeadingFusion::accuracy_weight(int android_accuracy) const {
+  return opt_.accuracy_weight[std::clamp(android_accuracy, 0, 3)];
+}
+
 double HeadingFusion::field_weight(const Eigen::Vector3d& field_ut, const Eigen::Vector3d& up_phone) const {
   if (!std::isfinite(ref_total_ut_)) return 1.0;
   const double f = field_ut.norm();

@@ -171,7 +171,13 @@ void Pdr::feed(const MagSample& s) {
   const auto compass =
       compass_heading_rad(s.field_ut, tracker_.up_phone(), reference_axis(), opt_.heading.min_horizontal);
   if (!compass) return;
-  absolute_heading(s.t_ns, *compass, fusion_.field_weight(s.field_ut, tracker_.up_phone()));
+  absolute_heading(s.t_ns, *compass, mag_accuracy_weight_ * fusion_.field_weight(s.field_ut, tracker_.up_phone()));
+}
+
+void Pdr::feed(const SensorAccuracySample& s) {
+  constexpr int kTypeMagneticField = 2, kTypeMagneticFieldUncalibrated = 14;  // android.hardware.Sensor
+  if (s.sensor_type == kTypeMagneticField || s.sensor_type == kTypeMagneticFieldUncalibrated)
+    mag_accuracy_weight_ = fusion_.accuracy_weight(s.accuracy);
 }
 
 void Pdr::feed(const RotationVectorSample& s) {
@@ -188,6 +194,7 @@ void Pdr::feed(const RotationVectorSample& s) {
   // the field it used, so it is weighted by the latest magnetometer reading's tests.
   const bool mag_fresh = have_mag_last_ && ns_to_s(s.t_ns - mag_last_ns_) <= opt_.heading.rv_max_age_s;
   double w = mag_fresh && tracker_.has_gravity() ? fusion_.field_weight(last_field_ut_, tracker_.up_phone()) : 1.0;
+  w *= mag_accuracy_weight_;
   // the sensor's own heading accuracy (when it reports one): inverse-variance relative to one
   // nominal reading, never above it
   if (std::isfinite(s.heading_accuracy_rad) && s.heading_accuracy_rad > 0.0)

@@ -37,6 +37,11 @@ struct HeadingFusionOptions {
   // gyro is still): the offset is unknown, the latest reading is followed (the pre-fusion
   // behaviour) until they agree again.
   double min_consistency = 0.5;
+  // Android's magnetometer accuracy (SensorEventListener.onAccuracyChanged: -1 no contact,
+  // 0 unreliable, 1 low, 2 medium, 3 high) is the state of its hard-iron calibration: an
+  // uncalibrated compass is tens of degrees off, so such readings count as disturbed ones.
+  // Multipliers of a reading's weight for accuracy 0..3 (below 0 = unreliable); no event = 1.
+  double accuracy_weight[4] = {0.05, 0.25, 0.6, 1.0};
 };
 
 class HeadingFusion {
@@ -47,6 +52,8 @@ class HeadingFusion {
   /// Weight of a magnetometer reading (phone axes) given "up" in phone axes: 1 if it passes
   /// the magnitude and dip tests (or no reference field is known), else disturbed_weight.
   double field_weight(const Eigen::Vector3d& field_ut, const Eigen::Vector3d& up_phone) const;
+  /// Weight multiplier for Android's magnetometer accuracy level (options.accuracy_weight).
+  double accuracy_weight(int android_accuracy) const;
   /// One absolute heading (magnetic, of the reference axis) at gyro yaw yaw_rad (left +).
   void add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, double weight, bool gyro_live);
   void reset();

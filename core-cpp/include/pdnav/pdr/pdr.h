@@ -76,6 +76,10 @@ class Pdr {
   void feed(const MagSample& s);
   void feed(const RotationVectorSample& s);
   void feed(const StepDetectorSample& s);
+  /// Android sensor accuracy events: the magnetometer's (TYPE_MAGNETIC_FIELD 2 and its
+  /// uncalibrated form 14) scales the weight of compass and rotation-vector headings
+  /// (HeadingFusionOptions::accuracy_weight); other sensors' events are ignored.
+  void feed(const SensorAccuracySample& s);
   /// Position and UTC time (Unix ms) for the WMM declination; may be called again at any time.
   void set_location(const geo::Geodetic& where, std::int64_t utc_ms);
   /// Replace the step-length model (e.g. the user's height read from a recorded session);
@@ -159,6 +163,7 @@ class Pdr {
   HeadingFusion fusion_;
   std::int64_t placement_revision_ = 0;
   Eigen::Vector3d last_field_ut_ = Eigen::Vector3d::Zero();
+  double mag_accuracy_weight_ = 1.0;  // no accuracy event yet: readings keep their own weight
   TimeNs last_gyro_ns_ = -1;
   double distance_m_ = 0.0;
   // the latest accelerometer step's swing, lent to Android step events (Weinberg needs one)
