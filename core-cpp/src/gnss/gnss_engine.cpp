@@ -103,11 +103,11 @@ struct GnssEngine::Impl {
     std::int64_t d_rx_ns = 0, d_full_bias_ns = 0;  // exact int64 differences; overflow = no link
     const bool rx_linked = had_prev && !__builtin_sub_overflow(ep.rx.ns, prev_rx.ns, &d_rx_ns);
     const bool linked = has_prev && rx_linked && !__builtin_sub_overflow(ep.full_bias_nanos, prev_full_bias_nanos, &d_full_bias_ns);
-    const double dt = linked ? static_cast<double>(d_rx_ns) * 1e-9 : 0.0;
+    const double dt_rx = rx_linked ? static_cast<double>(d_rx_ns) * 1e-9 : 0.0;
+    const double dt = linked ? dt_rx : 0.0;
     // Across a hardware clock discontinuity the GPS receive time stays continuous (FullBiasNanos
     // follows the re-set clock), so the code smoother keeps its satellites and propagates them by
     // Doppler, which does not see the receiver clock; the common-step removal takes the code jump.
-    const double dt_rx = rx_linked ? static_cast<double>(d_rx_ns) * 1e-9 : 0.0;
     const bool smooth_through_break =
         clock_break && opt.smoothing.doppler_through_clock_breaks && dt_rx > 0.0 && dt_rx <= opt.max_epoch_gap_s;
     if (has_prev && (!linked || !(dt > 0.0) || dt > opt.max_epoch_gap_s)) {

@@ -22,29 +22,17 @@ struct RecordError {
   std::string reason;
 };
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return {};
-  const auto e = s.find_last_not_of(" \t\r\n");
-  return s.substr(b, e - b + 1);
-}
-
-std::string field(const std::string& line, std::size_t col, std::size_t width) {
-  if (col >= line.size()) return {};
-  return line.substr(col, width);
-}
-
-std::string header_label(const std::string& line) { return trim(field(line, 60, 20)); }
+std::string header_label(const std::string& line) { return rinex_trim(rinex_field(line, 60, 20)); }
 
 double need_double(const std::string& f) {
   const auto v = parse_rinex_double(f);
-  if (!v) throw RecordError{"non-numeric field '" + trim(f) + "'"};
+  if (!v) throw RecordError{"non-numeric field '" + rinex_trim(f) + "'"};
   return *v;
 }
 
 int need_int(const std::string& f, int lo, int hi, const char* what) {
   const double v = need_double(f);
-  if (v != std::floor(v) || v < lo || v > hi) throw RecordError{std::string("bad ") + what + " '" + trim(f) + "'"};
+  if (v != std::floor(v) || v < lo || v > hi) throw RecordError{std::string("bad ") + what + " '" + rinex_trim(f) + "'"};
   return static_cast<int>(v);
 }
 
@@ -64,20 +52,20 @@ struct Epoch {
 Epoch parse_epoch(const std::string& l, const Layout& lay) {
   Epoch e{};
   if (lay.v3) {
-    e.year = need_int(field(l, 4, 4), 1980, 2200, "year");
-    e.month = need_int(field(l, 9, 2), 1, 12, "month");
-    e.day = need_int(field(l, 12, 2), 1, 31, "day");
-    e.hour = need_int(field(l, 15, 2), 0, 24, "hour");
-    e.minute = need_int(field(l, 18, 2), 0, 59, "minute");
-    e.second = need_double(field(l, 21, 2));
+    e.year = need_int(rinex_field(l, 4, 4), 1980, 2200, "year");
+    e.month = need_int(rinex_field(l, 9, 2), 1, 12, "month");
+    e.day = need_int(rinex_field(l, 12, 2), 1, 31, "day");
+    e.hour = need_int(rinex_field(l, 15, 2), 0, 24, "hour");
+    e.minute = need_int(rinex_field(l, 18, 2), 0, 59, "minute");
+    e.second = need_double(rinex_field(l, 21, 2));
   } else {
-    const int yy = need_int(field(l, 2, 3), 0, 99, "year");
+    const int yy = need_int(rinex_field(l, 2, 3), 0, 99, "year");
     e.year = yy < 80 ? 2000 + yy : 1900 + yy;
-    e.month = need_int(field(l, 5, 3), 1, 12, "month");
-    e.day = need_int(field(l, 8, 3), 1, 31, "day");
-    e.hour = need_int(field(l, 11, 3), 0, 24, "hour");
-    e.minute = need_int(field(l, 14, 3), 0, 59, "minute");
-    e.second = need_double(field(l, 17, 5));
+    e.month = need_int(rinex_field(l, 5, 3), 1, 12, "month");
+    e.day = need_int(rinex_field(l, 8, 3), 1, 31, "day");
+    e.hour = need_int(rinex_field(l, 11, 3), 0, 24, "hour");
+    e.minute = need_int(rinex_field(l, 14, 3), 0, 59, "minute");
+    e.second = need_double(rinex_field(l, 17, 5));
   }
   if (e.second < 0 || e.second > 61) throw RecordError{"bad second"};
   return e;
@@ -86,9 +74,9 @@ Epoch parse_epoch(const std::string& l, const Layout& lay) {
 /// All broadcast values of a record: 3 on the first line, 4 per continuation line.
 std::vector<double> record_values(const std::vector<Line>& rec, const Layout& lay) {
   std::vector<double> v;
-  for (int i = 0; i < 3; ++i) v.push_back(need_double(field(rec[0].text, lay.first_values_col() + 19 * i, 19)));
+  for (int i = 0; i < 3; ++i) v.push_back(need_double(rinex_field(rec[0].text, lay.first_values_col() + 19 * i, 19)));
   for (std::size_t k = 1; k < rec.size(); ++k)
-    for (int i = 0; i < 4; ++i) v.push_back(need_double(field(rec[k].text, lay.prefix() + 19 * i, 19)));
+    for (int i = 0; i < 4; ++i) v.push_back(need_double(rinex_field(rec[k].text, lay.prefix() + 19 * i, 19)));
   return v;
 }
 
@@ -194,14 +182,14 @@ class Parser {
     Line l;
     if (!next_line(l)) fail(0, "empty file");
     if (header_label(l.text) != "RINEX VERSION / TYPE") fail(l.number, "not a RINEX file (no RINEX VERSION / TYPE)");
-    const auto ver = parse_rinex_double(field(l.text, 0, 9));
-    if (!ver || *ver < 2.0 || *ver >= 4.0) fail(l.number, "unsupported RINEX version '" + trim(field(l.text, 0, 9)) + "'");
+    const auto ver = parse_rinex_double(rinex_field(l.text, 0, 9));
+    if (!ver || *ver < 2.0 || *ver >= 4.0) fail(l.number, "unsupported RINEX version '" + rinex_trim(rinex_field(l.text, 0, 9)) + "'");
     out_.version = *ver;
     lay_.v3 = *ver >= 3.0;
-    const char type = field(l.text, 20, 1).empty() ? ' ' : l.text[20];
+    const char type = rinex_field(l.text, 20, 1).empty() ? ' ' : l.text[20];
     if (lay_.v3) {
       if (type != 'N') fail(l.number, "not a navigation file (type '" + std::string(1, type) + "')");
-      out_.file_system = field(l.text, 40, 1).empty() ? 'G' : l.text[40];
+      out_.file_system = rinex_field(l.text, 40, 1).empty() ? 'G' : l.text[40];
     } else {
       if (type != 'N' && type != 'G') fail(l.number, "unsupported RINEX 2 file type '" + std::string(1, type) + "'");
       out_.file_system = type == 'G' ? 'R' : 'G';
@@ -219,7 +207,7 @@ class Parser {
     if (label == "ION ALPHA" || label == "ION BETA") {
       set_klobuchar(l, label == "ION ALPHA", 2);
     } else if (label == "IONOSPHERIC CORR") {
-      const std::string kind = field(l.text, 0, 4);
+      const std::string kind = rinex_field(l.text, 0, 4);
       if (kind == "GPSA" || kind == "GPSB") set_klobuchar(l, kind == "GPSA", 5);
     }
   }
@@ -227,7 +215,7 @@ class Parser {
   void set_klobuchar(const Line& l, bool alpha, std::size_t col) {
     std::array<double, 4> c{};
     for (std::size_t i = 0; i < 4; ++i) {
-      const auto v = parse_rinex_double(field(l.text, col + 12 * i, 12));
+      const auto v = parse_rinex_double(rinex_field(l.text, col + 12 * i, 12));
       if (!v) { issue(l.number, "bad ionosphere coefficients"); return; }
       c[i] = *v;
     }
@@ -236,14 +224,14 @@ class Parser {
   }
 
   bool is_record_start(const std::string& t) const {
-    return !trim(field(t, 0, lay_.prefix())).empty();
+    return !rinex_trim(rinex_field(t, 0, lay_.prefix())).empty();
   }
 
   void read_body() {
     std::vector<Line> rec;
     Line l;
     while (next_line(l)) {
-      if (trim(l.text).empty()) continue;
+      if (rinex_trim(l.text).empty()) continue;
       if (is_record_start(l.text)) {
         if (!rec.empty()) parse_record(rec);
         rec.clear();
@@ -261,10 +249,10 @@ class Parser {
     if (lay_.v3) {
       s.sys = constellation_from_rinex_letter(t[0]);
       if (s.sys == Constellation::kUnknown) throw RecordError{"unknown system '" + std::string(1, t[0]) + "'"};
-      s.prn = need_int(field(t, 1, 2), 1, 99, "satellite number");
+      s.prn = need_int(rinex_field(t, 1, 2), 1, 99, "satellite number");
     } else {
       s.sys = out_.file_system == 'R' ? Constellation::kGlonass : Constellation::kGps;
-      s.prn = need_int(field(t, 0, 2), 1, 99, "satellite number");
+      s.prn = need_int(rinex_field(t, 0, 2), 1, 99, "satellite number");
     }
     return s;
   }
@@ -306,8 +294,19 @@ class Parser {
 
 }  // namespace
 
+std::string rinex_field(const std::string& line, std::size_t col, std::size_t width) {
+  if (col >= line.size()) return {};
+  return line.substr(col, width);
+}
+
+std::string rinex_trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r\n");
+  if (b == std::string::npos) return {};
+  return s.substr(b, s.find_last_not_of(" \t\r\n") - b + 1);
+}
+
 std::optional<double> parse_rinex_double(const std::string& f) {
-  std::string s = trim(f);
+  std::string s = rinex_trim(f);
   if (s.empty()) return 0.0;
   for (char& c : s)
     if (c == 'D' || c == 'd') c = 'E';

@@ -16,21 +16,10 @@ namespace {
 constexpr std::int64_t kNsPerHour = 3600 * kNsPerS;
 const char* const kAndroidClockComment = "pdnav: Android clock bias in the epoch clock offset";
 
-std::string field(const std::string& line, std::size_t col, std::size_t width) {
-  if (col >= line.size()) return {};
-  return line.substr(col, width);
-}
-
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  if (b == std::string::npos) return {};
-  return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
-}
-
-std::string label(const std::string& l) { return trim(field(l, 60, 20)); }
+std::string label(const std::string& l) { return rinex_trim(rinex_field(l, 60, 20)); }
 
 bool parse_int(const std::string& f, int& out) {
-  const std::string t = trim(f);
+  const std::string t = rinex_trim(f);
   if (t.empty() || t.size() > 9) return false;
   int v = 0;
   std::size_t i = 0;
@@ -47,7 +36,7 @@ bool parse_int(const std::string& f, int& out) {
 
 /// "22.4299102" -> whole seconds and ns (exact, up to 9 decimals).
 bool parse_seconds(const std::string& f, int& s, std::int64_t& ns) {
-  const std::string t = trim(f);
+  const std::string t = rinex_trim(f);
   const auto dot = t.find('.');
   if (!parse_int(t.substr(0, dot), s)) return false;
   ns = 0;
@@ -120,7 +109,7 @@ std::int64_t RinexObsReport::skipped_total() const {
 
 bool looks_like_rinex_obs(const std::string& first_line) {
   return first_line.size() >= 61 && label(first_line) == "RINEX VERSION / TYPE" &&
-         (field(first_line, 20, 1) == "O" || field(first_line, 20, 16).find("OBSERVATION") != std::string::npos);
+         (rinex_field(first_line, 20, 1) == "O" || rinex_field(first_line, 20, 16).find("OBSERVATION") != std::string::npos);
 }
 
 double rinex_band_carrier_hz(Constellation sys, char band, int k) {
@@ -176,11 +165,11 @@ void RinexObsReader::read_header() {
   std::string l;
   if (!getline(l)) fail("empty file (no RINEX header)");
   if (!looks_like_rinex_obs(l)) fail("not a RINEX observation file (no 'OBSERVATION DATA' RINEX VERSION / TYPE line)");
-  const auto v = parse_rinex_double(field(l, 0, 9));
+  const auto v = parse_rinex_double(rinex_field(l, 0, 9));
   if (!v || *v < 3.0 || *v >= 4.0)
-    fail("RINEX observation version " + trim(field(l, 0, 9)) + " not supported (3.00-3.05 are)");
+    fail("RINEX observation version " + rinex_trim(rinex_field(l, 0, 9)) + " not supported (3.00-3.05 are)");
   header_.version = *v;
-  header_.file_system = field(l, 40, 1).empty() || field(l, 40, 1) == " " ? 'G' : l[40];
+  header_.file_system = rinex_field(l, 40, 1).empty() || rinex_field(l, 40, 1) == " " ? 'G' : l[40];
   char cont_sys = 0;
   int cont_left = 0;
   int glo_left = 0;
@@ -194,21 +183,21 @@ void RinexObsReader::read_header() {
       if (l[0] != ' ') {
         cont_sys = l[0];
         if (constellation_from_rinex_letter(cont_sys) == Constellation::kUnknown) fail("bad system letter in SYS / # / OBS TYPES");
-        if (!parse_int(field(l, 3, 3), n) || n < 0 || n > 99) fail("bad observation type count");
+        if (!parse_int(rinex_field(l, 3, 3), n) || n < 0 || n > 99) fail("bad observation type count");
         cont_left = n;
         header_.obs_types[cont_sys].clear();
       } else if (cont_left <= 0) {
         fail("SYS / # / OBS TYPES continuation without a system");
       }
       for (int i = 0; i < 13 && cont_left > 0; ++i, col += 4, --cont_left) {
-        const std::string t = trim(field(l, col, 3));
+        const std::string t = rinex_trim(rinex_field(l, col, 3));
         if (t.size() != 3) fail("bad observation type '" + t + "'");
         header_.obs_types[cont_sys].push_back(t);
       }
     } else if (lab == "GLONASS SLOT / FRQ #") {
       // I3,1X,8(A3,1X,I2,1X); read by tokens because some writers (Google's converter) shift
       // the columns by one
-      std::istringstream tok(field(l, 0, 60));
+      std::istringstream tok(rinex_field(l, 0, 60));
       std::string t;
       if (glo_left <= 0) {
         int n = 0;
@@ -227,13 +216,13 @@ void RinexObsReader::read_header() {
         header_.glonass_channel[slot] = k;
       }
     } else if (lab == "COMMENT") {
-      if (trim(field(l, 0, 60)) == kAndroidClockComment) header_.android_clock_offset = true;
+      if (rinex_trim(rinex_field(l, 0, 60)) == kAndroidClockComment) header_.android_clock_offset = true;
     } else if (lab == "TIME OF FIRST OBS") {
-      const std::string ts = trim(field(l, 48, 3));
+      const std::string ts = rinex_trim(rinex_field(l, 48, 3));
       if (!ts.empty()) header_.time_system = ts;
     } else if (lab == "APPROX POSITION XYZ") {
       for (int i = 0; i < 3; ++i) {
-        const auto x = parse_rinex_double(field(l, 14 * static_cast<std::size_t>(i), 14));
+        const auto x = parse_rinex_double(rinex_field(l, 14 * static_cast<std::size_t>(i), 14));
         header_.approx_xyz_m[i] = x ? *x : 0.0;
       }
     }
@@ -248,14 +237,14 @@ bool RinexObsReader::next(RinexObsEpoch& out) {
   std::string l;
   while (getline(l)) {
     if (l.empty() || l[0] != '>') {
-      if (!trim(l).empty()) skip("record outside an epoch");
+      if (!rinex_trim(l).empty()) skip("record outside an epoch");
       continue;
     }
     int y = 0, mo = 0, d = 0, h = 0, mi = 0, s = 0, flag = 0, n = 0;
     std::int64_t sub_ns = 0;
-    if (!parse_int(field(l, 2, 4), y) || !parse_int(field(l, 7, 2), mo) || !parse_int(field(l, 10, 2), d) ||
-        !parse_int(field(l, 13, 2), h) || !parse_int(field(l, 16, 2), mi) || !parse_seconds(field(l, 18, 11), s, sub_ns) ||
-        !parse_int(field(l, 31, 1), flag) || !parse_int(field(l, 32, 3), n) || n < 0) {
+    if (!parse_int(rinex_field(l, 2, 4), y) || !parse_int(rinex_field(l, 7, 2), mo) || !parse_int(rinex_field(l, 10, 2), d) ||
+        !parse_int(rinex_field(l, 13, 2), h) || !parse_int(rinex_field(l, 16, 2), mi) || !parse_seconds(rinex_field(l, 18, 11), s, sub_ns) ||
+        !parse_int(rinex_field(l, 31, 1), flag) || !parse_int(rinex_field(l, 32, 3), n) || n < 0) {
       skip("epoch: malformed epoch line");
       continue;
     }
@@ -285,7 +274,7 @@ bool RinexObsReader::next(RinexObsEpoch& out) {
     if (ts == "BDT") ns += 14 * kNsPerS;
     if (ts == "GLO") ns += geo::leap_seconds_at_gps_ns(ns) * kNsPerS;
     out.gps_ns = ns;
-    const std::string off = trim(field(epoch_line, 41, 15));
+    const std::string off = rinex_trim(rinex_field(epoch_line, 41, 15));
     if (!off.empty()) {
       const auto v = parse_rinex_double(off);
       if (v && std::fabs(*v) < 1e3) out.clock_offset_s = *v;
@@ -295,7 +284,7 @@ bool RinexObsReader::next(RinexObsEpoch& out) {
       SatId sat;
       sat.sys = constellation_from_rinex_letter(sl.empty() ? '?' : sl[0]);
       int prn = 0;
-      if (sl.size() < 3 || sat.sys == Constellation::kUnknown || !parse_int(field(sl, 1, 2), prn) || prn < 1) {
+      if (sl.size() < 3 || sat.sys == Constellation::kUnknown || !parse_int(rinex_field(sl, 1, 2), prn) || prn < 1) {
         skip("satellite: malformed satellite record");
         continue;
       }
@@ -307,9 +296,9 @@ bool RinexObsReader::next(RinexObsEpoch& out) {
       const auto& types = it->second;
       bool bad = false;
       for (std::size_t i = 0; i < types.size(); ++i) {
-        const std::string f = field(sl, 3 + 16 * i, 14);
-        const std::string lli = field(sl, 3 + 16 * i + 14, 1);
-        if (trim(f).empty()) continue;
+        const std::string f = rinex_field(sl, 3 + 16 * i, 14);
+        const std::string lli = rinex_field(sl, 3 + 16 * i + 14, 1);
+        if (rinex_trim(f).empty()) continue;
         const auto v = parse_rinex_double(f);
         if (!v) { bad = true; break; }
         const std::string& t = types[i];

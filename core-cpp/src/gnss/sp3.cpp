@@ -10,17 +10,6 @@
 namespace pdnav::gnss {
 namespace {
 
-std::string field(const std::string& line, std::size_t col, std::size_t width) {
-  if (col >= line.size()) return {};
-  return line.substr(col, width);
-}
-
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  if (b == std::string::npos) return {};
-  return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
-}
-
 class Sp3Parser {
  public:
   Sp3Parser(std::istream& in, std::string name) : in_(in), name_(std::move(name)) {}
@@ -35,7 +24,7 @@ class Sp3Parser {
       if (l.rfind("EOF", 0) == 0) break;
       if (l.rfind("%c", 0) == 0 && !time_system_seen_) {
         time_system_seen_ = true;
-        const std::string ts = trim(field(l, 9, 3));
+        const std::string ts = rinex_trim(rinex_field(l, 9, 3));
         if (!ts.empty() && ts != "ccc") out_.time_system = ts;
         offset_check();
       } else if (l[0] == '*') {
@@ -68,7 +57,7 @@ class Sp3Parser {
 
   double number(const std::string& f) const {
     const auto v = parse_rinex_double(f);
-    if (!v) fail("non-numeric field '" + trim(f) + "'");
+    if (!v) fail("non-numeric field '" + rinex_trim(f) + "'");
     return *v;
   }
 
@@ -81,12 +70,12 @@ class Sp3Parser {
   }
 
   void epoch_line(const std::string& l) {
-    const int y = integer(field(l, 3, 4));
-    const int mo = integer(field(l, 8, 2));
-    const int d = integer(field(l, 11, 2));
-    const int h = integer(field(l, 14, 2));
-    const int mi = integer(field(l, 17, 2));
-    const double s = number(field(l, 20, 11));
+    const int y = integer(rinex_field(l, 3, 4));
+    const int mo = integer(rinex_field(l, 8, 2));
+    const int d = integer(rinex_field(l, 11, 2));
+    const int h = integer(rinex_field(l, 14, 2));
+    const int mi = integer(rinex_field(l, 17, 2));
+    const double s = number(rinex_field(l, 20, 11));
     if (y < 1980 || y > 2200 || mo < 1 || mo > 12 || d < 1 || d > 31 || h < 0 || h > 23 || mi < 0 || mi > 59 || s < 0 ||
         s >= 61)
       fail("bad epoch");
@@ -99,11 +88,11 @@ class Sp3Parser {
     if (out_.epochs.empty()) fail("position record before the first epoch");
     SatId sat;
     sat.sys = constellation_from_rinex_letter(l.size() > 1 ? l[1] : '?');
-    const auto prn = parse_rinex_double(field(l, 2, 2));
-    const auto x = parse_rinex_double(field(l, 4, 14));
-    const auto y = parse_rinex_double(field(l, 18, 14));
-    const auto z = parse_rinex_double(field(l, 32, 14));
-    const auto c = parse_rinex_double(field(l, 46, 14));
+    const auto prn = parse_rinex_double(rinex_field(l, 2, 2));
+    const auto x = parse_rinex_double(rinex_field(l, 4, 14));
+    const auto y = parse_rinex_double(rinex_field(l, 18, 14));
+    const auto z = parse_rinex_double(rinex_field(l, 32, 14));
+    const auto c = parse_rinex_double(rinex_field(l, 46, 14));
     if (sat.sys == Constellation::kUnknown || !prn || *prn < 1 || *prn > 99 || !x || !y || !z || l.size() < 46) {
       ++out_.skipped_lines;
       return;
@@ -115,7 +104,7 @@ class Sp3Parser {
     sat.prn = static_cast<int>(*prn);
     Sp3Sample s;
     s.pos = geo::Ecef(*x * 1e3, *y * 1e3, *z * 1e3);
-    s.has_clock = c && std::abs(*c) < 999999.0 && trim(field(l, 46, 14)) != "";
+    s.has_clock = c && std::abs(*c) < 999999.0 && rinex_trim(rinex_field(l, 46, 14)) != "";
     s.clock_s = s.has_clock ? *c * 1e-6 : 0.0;
     out_.epochs.back().sats[sat] = s;
   }

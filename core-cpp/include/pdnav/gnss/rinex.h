@@ -29,6 +29,11 @@ RinexNavData read_rinex_nav(std::istream& in, const std::string& name);
 /// Same, from a file; throws std::runtime_error("path:0: cannot open") when unreadable.
 RinexNavData read_rinex_nav_file(const std::string& path);
 
+/// Columns [col, col + width) of a fixed-column RINEX / SP3 / clock line ("" past its end).
+std::string rinex_field(const std::string& line, std::size_t col, std::size_t width);
+/// `s` without leading and trailing blanks (space, tab, CR, LF).
+std::string rinex_trim(const std::string& s);
+
 /// Parse one RINEX floating field ("-0.123D-04", blanks -> 0). nullopt when not a finite number.
 std::optional<double> parse_rinex_double(const std::string& field);
 
