@@ -250,6 +250,29 @@ struct CloudMoments {
   double sw = 0, me = 0, mn = 0, cee = 0, cnn = 0, cen = 0;
 };
 
+/// The same moments in double, particle by particle: used when the float partials overflow (a
+/// cloud spread over more than ~1e19 m, e.g. dead reckoning fed absurd steps), so the estimate
+/// stays finite as it was before the float lanes.
+CloudMoments cloud_moments_double(const float* e, const float* n, const float* w, std::size_t count) {
+  CloudMoments c;
+  double se = 0, sn = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    c.sw += w[i];
+    se += static_cast<double>(w[i]) * e[i];
+    sn += static_cast<double>(w[i]) * n[i];
+  }
+  if (!(c.sw > 0.0)) c.sw = 1.0;
+  c.me = se / c.sw;
+  c.mn = sn / c.sw;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double wi = w[i], de = e[i] - c.me, dn = n[i] - c.mn;
+    c.cee += wi * de * de / c.sw;
+    c.cnn += wi * dn * dn / c.sw;
+    c.cen += wi * de * dn / c.sw;
+  }
+  return c;
+}
+
 CloudMoments cloud_moments(const float* e, const float* n, const float* w, std::size_t count) {
   using detail::Float4;
   using detail::load4;
@@ -315,6 +338,9 @@ CloudMoments cloud_moments(const float* e, const float* n, const float* w, std::
   c.cee = std::max(0.0, see / c.sw - mde * mde);
   c.cnn = std::max(0.0, snn / c.sw - mdn * mdn);
   c.cen = sen / c.sw - mde * mdn;
+  if (!std::isfinite(c.me) || !std::isfinite(c.mn) || !std::isfinite(c.cee) || !std::isfinite(c.cnn) ||
+      !std::isfinite(c.cen))
+    return cloud_moments_double(e, n, w, count);
   return c;
 }
 
