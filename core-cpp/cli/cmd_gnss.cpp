@@ -17,6 +17,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "pdnav/geo/time.h"
 #include "pdnav/gnss/gnss_engine.h"
 #include "pdnav/gnss/rinex_obs.h"
 #include "pdnav/gnss/solver_metrics.h"
@@ -34,6 +35,7 @@ struct GnssArgs {
   std::string truth;
   std::string truth_csv;
   std::string out;
+  std::string residuals_out;
   bool strip_adr = false;
   double smoothing_window_s = gnss::SmoothingOptions{}.window_s;
   std::uint64_t seed = 1;
@@ -239,6 +241,52 @@ void print_accuracy(const gnss::StaticAccuracy& a) {
               a.doppler_rms_enu_m.x() * 100, a.doppler_rms_enu_m.y() * 100, a.doppler_rms_enu_m.z() * 100, a.doppler_epochs);
 }
 
+/// Code residuals at the truth (static or track) of every epoch, raw and smoothed code, one
+/// row per satellite: the input of tools/gnss-noise-fit (docs/gnss.md "Code noise model").
+void write_residuals(const std::string& path, const std::vector<gnss::EpochSolution>& sols, const GnssArgs& a,
+                     const gnss::EphemerisStore& store, const gnss::SppOptions& spp) {
+  const bool have_static = !a.truth.empty();
+  if (!have_static && a.truth_csv.empty()) throw std::runtime_error("--residuals-out needs --truth or --truth-csv");
+  const geo::Geodetic fixed = have_static ? parse_truth(a.truth) : geo::Geodetic();
+  const gnss::TruthTrack track = have_static ? gnss::TruthTrack() : gnss::read_truth_csv_file(a.truth_csv);
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot write");
+  f << "gps_ns,sys,svid,band,cn0_dbhz,el_deg,raw_m,smoothed_m,group_size,iono_free\n";
+  std::int64_t rows = 0, epochs = 0;
+  for (const gnss::EpochSolution& s : sols) {
+    if (s.code_obs.empty()) continue;
+    geo::Geodetic g = fixed;
+    if (!have_static && !gnss::truth_at(track, s.gps_ns, g)) continue;
+    const geo::Ecef truth = geo::to_ecef(g);
+    const double tow = geo::gps_ns_to_week_tow(s.gps_ns).tow_s;
+    std::vector<gnss::SppObservation> raw = s.code_obs;
+    for (std::size_t i = 0; i < raw.size() && i < s.code_raw_m.size(); ++i) raw[i].pseudorange_m = s.code_raw_m[i];
+    // a truth track's height is estimated (GSDC 2021 heights are tens of metres off the
+    // phone's: docs/gnss.md); a static survey point's is used
+    gnss::TruthResidualOptions ro;
+    ro.estimate_height = !have_static;
+    const auto r_raw = gnss::residuals_at_truth(raw, truth, tow, store.klobuchar(), spp, ro);
+    const auto r_sm = gnss::residuals_at_truth(s.code_obs, truth, tow, store.klobuchar(), spp, ro);
+    std::map<gnss::SatId, double> smoothed;
+    for (const auto& r : r_sm) smoothed[r.sat] = r.residual_m;
+    std::map<gnss::SatId, bool> iono_free;
+    for (const auto& o : s.code_obs) iono_free[o.sat] = o.iono_free;
+    for (const auto& r : r_raw) {
+      const auto it = smoothed.find(r.sat);
+      char line[256];
+      std::snprintf(line, sizeof line, "%lld,%c,%d,%s,%.2f,%.3f,%.4f,%.4f,%d,%d\n", static_cast<long long>(s.gps_ns),
+                    gnss::rinex_letter(r.sat.sys), r.sat.prn, gnss::to_string(gnss::signal_band(r.carrier_hz)),
+                    r.cn0_dbhz, r.el_rad * 180.0 / kPi, r.residual_m, it == smoothed.end() ? kNaN : it->second,
+                    r.group_size, iono_free[r.sat] ? 1 : 0);
+      f << line;
+      ++rows;
+    }
+    ++epochs;
+  }
+  if (!f) throw std::runtime_error(path + ": write failed");
+  std::cout << "residuals: " << path << " (" << rows << " code residuals at the truth, " << epochs << " epochs)\n";
+}
+
 void run_gnss(const GnssArgs& a) {
   const auto store = load_nav(a.nav);
   for (const std::string& f : a.sp3) {
@@ -262,13 +310,16 @@ void run_gnss(const GnssArgs& a) {
   options.measurements.dual_min_sats = a.dual_min_sats;
   options.measurements.dual_min_fraction = a.dual_min_fraction;
   options.measurements.dual_keep_single = a.dual_keep_single;
-  options.measurements.frequency = a.freq == "dual" ? gnss::FrequencyMode::kDual : gnss::FrequencyMode::kSingle;
+  options.measurements.frequency = a.freq == "dual" ? gnss::FrequencyMode::kDual
+                                   : a.freq == "l5" ? gnss::FrequencyMode::kL5
+                                                    : gnss::FrequencyMode::kSingle;
   options.kalman.displacement_q_m2 = a.kf_displacement_q_m2;
   options.kalman.fix_variance_scale = a.kf_fix_scale;
   gnss::parse_kf_dynamics(a.dynamics, options.kalman.dynamics);  // validated by CLI11
   options.kalman.accel_psd_h_m2ps3 = a.kf_accel_psd;
   options.spp.fde = a.spp_fde == "largest" ? gnss::SppFde::kLargestResidual : gnss::SppFde::kSubsets;
   options.spp.robust_igg3 = a.spp_igg3;
+  options.record_code_observations = !a.residuals_out.empty();
   gnss::GnssEngine engine(options, store, a.seed);
   std::int64_t raw_rows = 0;
   const std::vector<gnss::EpochSolution> sols = run(a, engine, raw_rows);
@@ -284,6 +335,7 @@ void run_gnss(const GnssArgs& a) {
     std::cout << "csv: " << a.out << " (" << sols.size() << " epochs; e/n/u relative to "
               << (have_truth ? "the truth" : "the first KF fix") << ")\n";
   }
+  if (!a.residuals_out.empty()) write_residuals(a.residuals_out, sols, a, *store, options.spp);
   const gnss::StaticAccuracy acc = gnss::evaluate_static(sols, truth);
   if (have_truth) print_accuracy(acc);
   if (!a.truth_csv.empty()) {
@@ -322,6 +374,9 @@ void register_gnss(CLI::App& app) {
                   "per-epoch truth track, GSDC columns millisSinceGpsEpoch,latDeg,lngDeg,heightAboveWgs84EllipsoidM")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "per-epoch CSV (tools/plot.py gnss CSV)");
+  cmd->add_option("--residuals-out", args->residuals_out,
+                  "per-satellite code residuals at the truth (raw and smoothed; needs --truth or --truth-csv), "
+                  "input of tools/gnss-noise-fit");
   cmd->add_flag("--strip-adr", args->strip_adr, "drop carrier phase (tests the Doppler fallback)");
   cmd->add_option("--smoothing-window", args->smoothing_window_s,
                   "carrier smoothing window of the code, s (RTCA DO-229: 100; 0 = raw code)")->check(CLI::Range(0.0, 3600.0));
@@ -343,8 +398,8 @@ void register_gnss(CLI::App& app) {
       ->check(CLI::Range(1, 3600));
   cmd->add_option("--freq", args->freq,
                   "single: L1/E1/B1 + Klobuchar; dual: L1/L5 (E1/E5a) ionosphere-free code per clock group "
-                  "where enough satellites track both bands (docs/gnss.md)")
-      ->check(CLI::IsMember({"single", "dual"}));
+                  "where enough satellites track both bands (docs/gnss.md); l5: L5/E5a/B2a alone")
+      ->check(CLI::IsMember({"single", "dual", "l5"}));
   cmd->add_option("--iono-window", args->iono_window_s,
                   "dual: averaging window of the IF ionosphere correction, s (0 = raw IF code)")
       ->check(CLI::Range(0.0, 1e5));

@@ -68,7 +68,7 @@ std::vector<SppObservation> to_spp(const Scenario& s, bool use_if_flags) {
     SppObservation o{m.sat, m.pseudorange_m, m.cn0_dbhz, 1575.42e6, s.sky[i].state};
     if (use_if_flags) {
       o.iono_free = m.iono_free;
-      o.var_scale = m.var_scale;
+      o.cn0_l5_dbhz = m.cn0_l5_dbhz;
     }
     obs.push_back(o);
   }
@@ -91,8 +91,12 @@ TEST(DualFrequency, IonosphereFreeCodeRemovesAKnownIonosphere) {
   combine_dual_frequency(s.meas, opt, ex);
   for (const Measurement& m : s.meas) {
     EXPECT_TRUE(m.iono_free) << m.sat.to_string();
-    // equal C/N0 on both bands: the IF variance is alpha^2 + beta^2 = 6.70 x the L1 variance
-    EXPECT_NEAR(m.var_scale, kIfAlpha * kIfAlpha + kIfBeta * kIfBeta, 1e-9);
+    EXPECT_EQ(m.cn0_l5_dbhz, 40.0);
+    // equal noise model and C/N0 on both bands: the IF variance is alpha^2 + beta^2 = 6.70 x L1
+    const CodeNoiseModel same = CodeNoiseModel::uniform(4.0, 1.6e5);
+    EXPECT_NEAR(iono_free_variance_m2(same, m.sat.sys, 40.0, 40.0, 0.7) /
+                    same.variance_m2(m.sat.sys, 1575.42e6, 40.0, 0.7),
+                kIfAlpha * kIfAlpha + kIfBeta * kIfBeta, 1e-9);
   }
   EXPECT_EQ(ex["dual: ionosphere-free code used"], 10);
   const KlobucharParams k = klobuchar();
@@ -125,7 +129,6 @@ TEST(DualFrequency, GroupWithFewL5SatellitesFallsBackToL1) {
     if (m.sat.sys == Constellation::kGalileo) {
       EXPECT_FALSE(m.iono_free);
       EXPECT_EQ(m.pseudorange_m, before.meas[i].pseudorange_m);  // single frequency, unchanged
-      EXPECT_EQ(m.var_scale, 1.0);
     } else if (dual[i]) {
       EXPECT_TRUE(m.iono_free);
       ++gps_if;

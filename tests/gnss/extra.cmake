@@ -19,3 +19,10 @@ set_tests_properties(gnss.rtklib_reads_pdnav_rinex PROPERTIES LABELS "gnss;cli" 
 add_test(NAME gnss.cli_gsdc_kinematic_kf
   COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/gnss/check_gsdc_kf.py" "$<TARGET_FILE:pdnav>" "${PDNAV_SHARED_DATA_DIR}")
 set_tests_properties(gnss.cli_gsdc_kinematic_kf PROPERTIES LABELS "gnss;cli" TIMEOUT 120)
+
+# Issue 15: the per-signal code noise defaults are reproduced by tools/gnss-noise-fit from the
+# shared GSDC and Mountain View residuals at the truth (docs/gnss.md "Code noise model").
+add_test(NAME gnss.noise_model_fit_reproduces_defaults
+  COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/gnss/check_noise_fit.py" "$<TARGET_FILE:pdnav>"
+          "${PDNAV_SHARED_DATA_DIR}" "${CMAKE_CURRENT_SOURCE_DIR}/..")
+set_tests_properties(gnss.noise_model_fit_reproduces_defaults PROPERTIES LABELS "gnss;cli" TIMEOUT 300)

@@ -37,8 +37,16 @@ TEST(KalmanFilter, AveragesNoisyFixesWithZeroDisplacement) {
   EXPECT_GT(enu.eigenvalues().real().minCoeff(), 0.0);
 }
 
+/// The robust tests below are about the rejection mechanism: R scaled x4 (sigma x2), not the
+/// default's measured correlation, so a 60 m fault is 10 sigma of the fix.
+KalmanOptions scale4() {
+  KalmanOptions o;
+  o.fix_variance_scale = 4.0;
+  return o;
+}
+
 TEST(KalmanFilter, PosteriorResidualTestRejectsOutliers) {
-  RobustKalman kf;
+  RobustKalman kf(scale4());
   kf.reset(kTruth, Eigen::Matrix3d::Identity() * 1.0, 0.0, 1.0);
   kf.predict(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity() * 1e-4, 0.0, 1e-4);
   const Eigen::Vector3d before = kf.position().p_m;
@@ -91,7 +99,7 @@ TEST(KalmanFilter, CoastingGrowsTheCovarianceAndBadInputIsIgnored) {
 }
 
 TEST(KalmanFilter, WalkerPosteriorTestStillRejectsWithoutIgg3) {
-  KalmanOptions opt;
+  KalmanOptions opt = scale4();
   opt.robust_igg3 = false;
   RobustKalman kf(opt);
   kf.reset(kTruth, Eigen::Matrix3d::Identity() * 1.0, 0.0, 1.0);
@@ -120,11 +128,13 @@ TEST(KalmanFilter, Igg3WeightsFollowYang2002) {
 }
 
 TEST(KalmanFilter, FixScaleFollowsTheAr1CorrelationOverTheFixInterval) {
-  const KalmanOptions o;  // 4 at 1 s
-  EXPECT_NEAR(fix_variance_scale_for(o, 1.0), 4.0, 1e-12);
-  EXPECT_NEAR(fix_variance_scale_for(o, 5.0), (1 + std::pow(0.6, 5)) / (1 - std::pow(0.6, 5)), 1e-12);
-  EXPECT_GT(fix_variance_scale_for(o, 0.5), 4.0);
-  EXPECT_LT(fix_variance_scale_for(o, 30.0), 1.001);
+  const KalmanOptions o;  // 12.3 at 1 s: rho = 0.85
+  const double s1 = o.fix_variance_scale, rho = (s1 - 1.0) / (s1 + 1.0);
+  EXPECT_NEAR(rho, 0.85, 0.005);
+  EXPECT_NEAR(fix_variance_scale_for(o, 1.0), s1, 1e-12);
+  EXPECT_NEAR(fix_variance_scale_for(o, 5.0), (1 + std::pow(rho, 5)) / (1 - std::pow(rho, 5)), 1e-12);
+  EXPECT_GT(fix_variance_scale_for(o, 0.5), s1);
+  EXPECT_LT(fix_variance_scale_for(o, 60.0), 1.001);
   KalmanOptions none;
   none.fix_variance_scale = 1.0;
   EXPECT_EQ(fix_variance_scale_for(none, 5.0), 1.0);

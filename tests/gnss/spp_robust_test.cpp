@@ -24,8 +24,7 @@ SppOptions fde_only(SppFde method) {
   o.robust_igg3 = false;  // the FDE alone
   o.fde = method;
   // weights that match the simulated noise: 1 m at zenith (noise 0.5 m), mapped by elevation
-  o.code_var_a_m2 = 1.0;
-  o.code_var_b_m2 = 0.0;
+  o.code_noise = CodeNoiseModel::uniform(1.0, 0.0);
   return o;
 }
 

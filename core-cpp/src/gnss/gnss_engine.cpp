@@ -126,7 +126,8 @@ struct GnssEngine::Impl {
       if (m.code_ok()) {
         sm_in.push_back(SmoothingInput{m.sat, m.pseudorange_m, m.adr_ok() ? m.adr_m : kNaN, m.pr_rate_mps, m.iono_free,
                                        m.pseudorange_l1_m});
-        spp_obs.push_back(SppObservation{m.sat, m.pseudorange_m, m.cn0_dbhz, carrier_hz(m, st), st, m.iono_free, m.var_scale});
+        spp_obs.push_back(SppObservation{m.sat, m.pseudorange_m, m.cn0_dbhz, carrier_hz(m, st), st, m.iono_free, 1.0,
+                                         m.iono_free ? m.cn0_l5_dbhz : kNaN});
       }
       CarrierObservation c;
       c.sat = m.sat;
@@ -150,6 +151,10 @@ struct GnssEngine::Impl {
         count("smoothing: common code-carrier step removed (> 1 m)");
     }
     EpochSolution sol;
+    if (opt.record_code_observations) {
+      sol.code_obs = spp_obs;
+      for (const SmoothingInput& in : sm_in) sol.code_raw_m.push_back(in.pseudorange_m);
+    }
     sol.t_ns = ep.t_ns;
     sol.gps_ns = ep.rx.ns;
     sol.sats_tracked = static_cast<int>(rows.size());

@@ -197,7 +197,6 @@ void combine_dual_frequency(std::vector<Measurement>& meas, const MeasurementOpt
     code_sats[g].push_back(i);
     if (std::isfinite(m.pseudorange_l5_m) && std::isfinite(m.cn0_l5_dbhz)) dual_sats[g].push_back(i);
   }
-  auto noise_var = [&](double cn0) { return opt.dual_var_a_m2 + opt.dual_var_b_m2 * std::pow(10.0, -cn0 / 10.0); };
   for (const auto& [g, all] : code_sats) {
     const auto it = dual_sats.find(g);
     const std::size_t n_dual = it == dual_sats.end() ? 0 : it->second.size();
@@ -223,7 +222,6 @@ void combine_dual_frequency(std::vector<Measurement>& meas, const MeasurementOpt
       m.pseudorange_l1_m = m.pseudorange_m;
       m.pseudorange_m += kIfBeta * dev;
       m.iono_free = true;
-      m.var_scale = kIfAlpha * kIfAlpha + kIfBeta * kIfBeta * noise_var(m.cn0_l5_dbhz) / noise_var(m.cn0_dbhz);
       combined[it->second[k]] = true;
       ++excluded["dual: ionosphere-free code used"];
     }
@@ -294,6 +292,7 @@ bool build_epoch(const std::vector<GnssRawSample>& rows, const MeasurementOption
   out.leap_seconds = (c.leap_second != kMissingInt && c.leap_second >= 0 && c.leap_second < 100)
                          ? static_cast<int>(c.leap_second) : geo::leap_seconds_at_gps_ns(out.rx.ns);
   const bool dual = opt.frequency == FrequencyMode::kDual;
+  const bool l5_only = opt.frequency == FrequencyMode::kL5;
   std::vector<Measurement> l5;  // second-band codes (dual mode)
   for (const GnssRawSample& r : rows) {
     Measurement m;
@@ -306,7 +305,8 @@ bool build_epoch(const std::vector<GnssRawSample>& rows, const MeasurementOption
     if (finite_and_small(r.carrier_frequency_hz, 1e10) && r.carrier_frequency_hz > 1e8) m.carrier_hz = r.carrier_frequency_hz;
     if (r.code_type.size() <= 4) m.code_type = r.code_type;
     const bool second = dual && l5_band(m.sat.sys, m.carrier_hz);
-    if (!second && !l1_band(m.sat.sys, m.carrier_hz)) {
+    if (l5_only && !l5_band(m.sat.sys, m.carrier_hz)) { ++excluded["signal: not L5/E5a/B2a (--freq l5)"]; continue; }
+    if (!l5_only && !second && !l1_band(m.sat.sys, m.carrier_hz)) {
       ++excluded[dual ? "signal: neither L1/E1/B1 nor L5/E5a" : "signal: not L1/E1/B1 (one band used)"];
       continue;
     }

@@ -99,7 +99,9 @@ Row model_row(const SppObservation& o, const Eigen::VectorXd& x, const Layout& l
   }
   const double sat_clock_m = kSpeedOfLight_mps * (o.state.clock_bias_s - (o.iono_free ? 0.0 : signal_group_delay_s(o)));
   r.residual_m = o.pseudorange_m - (range + clock - sat_clock_m + atmo_m);
-  r.var_m2 = o.var_scale * cn0_elevation_variance(opt.code_var_a_m2, opt.code_var_b_m2, o.cn0_dbhz, r.el_rad);
+  r.var_m2 = o.var_scale * (o.iono_free && std::isfinite(o.cn0_l5_dbhz)
+                                ? iono_free_variance_m2(opt.code_noise, o.sat.sys, o.cn0_dbhz, o.cn0_l5_dbhz, r.el_rad)
+                                : opt.code_noise.variance_m2(o.sat.sys, o.carrier_hz, o.cn0_dbhz, r.el_rad));
   return r;
 }
 
@@ -337,9 +339,78 @@ double normal_upper_quantile(double p) {
 
 }  // namespace
 
-double cn0_elevation_variance(double a, double b, double cn0_dbhz, double el_rad) {
-  const double s = std::max(std::sin(el_rad), 0.1);
-  return a / (s * s) + b * std::pow(10.0, -cn0_dbhz / 10.0);
+std::vector<TruthResidual> residuals_at_truth(const std::vector<SppObservation>& obs, const geo::Ecef& truth,
+                                              double gps_tow_s, const KlobucharParams* klob, const SppOptions& opt,
+                                              const TruthResidualOptions& ropt) {
+  std::vector<const SppObservation*> all;
+  for (const auto& o : obs)
+    if (std::isfinite(o.pseudorange_m) && o.state.pos.p_m.allFinite() && std::isfinite(o.cn0_dbhz)) all.push_back(&o);
+  std::vector<TruthResidual> out;
+  if (all.empty() || !truth.p_m.allFinite()) return out;
+  const Layout l = make_layout(all);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(l.cols);  // clocks 0: estimated below
+  x.head<3>() = truth.p_m;
+  std::map<Constellation, int> count;
+  std::vector<Eigen::Vector3d> los;
+  for (const SppObservation* o : all) {
+    const Row r = model_row(*o, x, l, gps_tow_s, klob, opt);
+    if (r.masked || !std::isfinite(r.residual_m)) continue;
+    ++count[clock_group(o->sat.sys)];
+    out.push_back(TruthResidual{o->sat, o->carrier_hz, o->cn0_dbhz, r.el_rad, r.residual_m, 0});
+    los.push_back(r.los);
+  }
+  // unknowns: one clock per kept group, then the height offset (when estimated)
+  std::map<Constellation, int> col;
+  for (const auto& [g, n] : count) if (n >= std::max(2, ropt.min_group)) col.emplace(g, static_cast<int>(col.size()));
+  const int p = static_cast<int>(col.size()) + (ropt.estimate_height ? 1 : 0);
+  std::vector<std::size_t> rows;
+  for (std::size_t i = 0; i < out.size(); ++i) if (col.count(clock_group(out[i].sat.sys))) rows.push_back(i);
+  const int n = static_cast<int>(rows.size());
+  if (col.empty() || n <= p) return {};
+  const Eigen::Vector3d up = truth.p_m.normalized();
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(n, p);
+  Eigen::VectorXd y(n), w = Eigen::VectorXd::Ones(n), e(n);
+  for (int k = 0; k < n; ++k) {
+    const TruthResidual& t = out[rows[static_cast<std::size_t>(k)]];
+    h(k, col.at(clock_group(t.sat.sys))) = 1.0;
+    if (ropt.estimate_height) h(k, p - 1) = -los[rows[static_cast<std::size_t>(k)]].dot(up);
+    y(k) = t.residual_m;
+  }
+  // least absolute deviations by iteratively reweighted least squares (w = 1 / max(|e|, 0.1 m)):
+  // the clocks follow the median satellite, not the multipath tails
+  for (int pass = 0; pass < 20; ++pass) {
+    const Eigen::MatrixXd hw = w.asDiagonal() * h;
+    const Eigen::VectorXd sol = (h.transpose() * hw).ldlt().solve(hw.transpose() * y);
+    e = y - h * sol;
+    for (int k = 0; k < n; ++k) w(k) = 1.0 / std::max(std::fabs(e(k)), 0.1);
+  }
+  // Each residual against its group's clock from the *other* satellites (leave-one-out median
+  // of the height-corrected codes): no residual is forced to zero by the fit, and the variance
+  // the median adds is divided out: var(median of m) = sigma^2 / 2 for m = 2, ~pi sigma^2 / (2 m)
+  // beyond (Kenney & Keeping 1962, the median's asymptotic variance).
+  Eigen::VectorXd yh = y;
+  if (ropt.estimate_height) {
+    const Eigen::MatrixXd hw = w.asDiagonal() * h;
+    const Eigen::VectorXd sol = (h.transpose() * hw).ldlt().solve(hw.transpose() * y);
+    yh -= h.col(p - 1) * sol(p - 1);
+  }
+  std::vector<TruthResidual> kept;
+  for (int k = 0; k < n; ++k) {
+    TruthResidual t = out[rows[static_cast<std::size_t>(k)]];
+    const Constellation g = clock_group(t.sat.sys);
+    std::vector<double> others;
+    for (int j = 0; j < n; ++j)
+      if (j != k && clock_group(out[rows[static_cast<std::size_t>(j)]].sat.sys) == g) others.push_back(yh(j));
+    const std::size_t m = others.size();
+    std::nth_element(others.begin(), others.begin() + static_cast<std::ptrdiff_t>(m / 2), others.end());
+    double clock = others[m / 2];
+    if (m % 2 == 0) clock = 0.5 * (clock + *std::max_element(others.begin(), others.begin() + static_cast<std::ptrdiff_t>(m / 2)));
+    const double added = m == 2 ? 0.5 : kPi / (2.0 * static_cast<double>(m));
+    t.residual_m = (yh(k) - clock) / std::sqrt(1.0 + added);
+    t.group_size = count.at(g);
+    kept.push_back(t);
+  }
+  return kept;
 }
 
 double chi_square_quantile(double p_false_alarm, int dof) {

@@ -35,6 +35,8 @@ struct GnssOptions {
   /// Scale the SPP covariance given to the KF by max(1, chi2/dof), the a-posteriori variance
   /// of unit weight (Teunissen, Adjustment Theory 2003, Sec. 4.3); docs/gnss.md has the effect.
   bool scale_fix_by_variance_factor = true;
+  /// Keep each epoch's SPP inputs in EpochSolution::code_obs (noise-model learning; off in use).
+  bool record_code_observations = false;
 };
 
 /// One receiver epoch's result.
@@ -63,6 +65,10 @@ struct EpochSolution {
   /// The engine status after this epoch (what estimate() returns then): kOk, kDegraded (coasting
   /// or fewer than min_sats_ok satellites; still a usable position), kLost, kNotInitialized.
   EstimateStatus status = EstimateStatus::kNotInitialized;
+  /// With GnssOptions::record_code_observations: the SPP's code observations (smoothed as the
+  /// SPP used them) and, in the same order, the code before smoothing.
+  std::vector<SppObservation> code_obs;
+  std::vector<double> code_raw_m;
 };
 
 class GnssEngine {

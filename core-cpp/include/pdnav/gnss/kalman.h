@@ -44,14 +44,13 @@ struct KalmanOptions {
   double drift_q_m2ps3 = 1e2;             // clock-drift random walk (TCXO under temperature change)
   double initial_velocity_var_m2ps2 = 400.0;  // (20 m/s)^2 before any velocity measurement
   // The SPP covariance treats each fix as independent; phone code errors are correlated over
-  // tens of seconds (multipath), so R is inflated x4 (sigma x2) to keep the KF covariance
-  // honest (68 % coverage 0.70 on the GSDC drive instead of 0.32; docs/gnss.md).
-  // The scale is for fixes 1 s apart. Modelling the fix error as AR(1) with correlation rho per
-  // 1 s, treating it as white overstates the information by (1 + rho) / (1 - rho) (the
-  // effective sample size of a correlated series, von Storch & Zwiers 1999, Sec. 17.1.3):
-  // 4 at 1 s means rho = 0.6 (tau = 1.96 s), so fixes dt apart get (1 + rho^dt) / (1 - rho^dt),
-  // 1.17 at 5 s (duty cycling). fix_variance_scale_for(dt) computes it.
-  double fix_variance_scale = 4.0;
+  // tens of seconds (multipath). Modelling the fix error as AR(1) with correlation rho per 1 s,
+  // treating it as white overstates the information by (1 + rho) / (1 - rho) (the effective
+  // sample size of a correlated series, von Storch & Zwiers 1999, Sec. 17.1.3). rho measured
+  // on the SPP errors against truth (docs/gnss.md "Code noise model"): 0.81 / 0.89 (north /
+  // east) on the moving GSDC car, 0.92-0.95 on the static Mountain View phone; rho = 0.85
+  // gives 12.3. Fixes dt apart get (1 + rho^dt) / (1 - rho^dt) (fix_variance_scale_for(dt)).
+  double fix_variance_scale = 12.3;
   double min_fix_variance_m2 = 1.0;       // floor of each axis of R (phone code errors are never < 1 m)
   double min_velocity_variance_m2ps2 = 0.01;  // floor of each axis of a velocity measurement
   // IGG-III (Yang et al. 2002): full weight up to k0, zero beyond k1, on the standardised

@@ -71,7 +71,6 @@ struct Measurement {
   // ionosphere-free code referenced to the L1 receiver clock (see combine_dual_frequency);
   // ADR, Doppler, C/N0, carrier_hz and code_type stay those of the L1 signal.
   bool iono_free = false;
-  double var_scale = 1.0;               // code variance factor vs the L1 model (IF: alpha^2 + beta^2 v5/v1)
   double pseudorange_l1_m = kNaN;       // the L1 code before the combination (NaN when not combined)
   double pseudorange_l5_m = kNaN;       // the L5/E5a code of the same satellite, NaN when not tracked
   double cn0_l5_dbhz = kNaN;
@@ -97,7 +96,10 @@ struct MeasurementEpoch {
 ///   kDual:   per clock group (GPS+QZSS, Galileo, ...) and epoch, the L1/L5 ionosphere-free
 ///            code when enough of the group's satellites track both bands (otherwise the whole
 ///            group stays single frequency + Klobuchar: see combine_dual_frequency).
-enum class FrequencyMode { kSingle, kDual };
+/// kSingle: L1/E1/B1 code, Klobuchar; kDual: L1/L5 ionosphere-free per clock group; kL5: the
+/// L5/E5a/B2a signal alone (code, Doppler, carrier), Klobuchar scaled to its frequency (noise-
+/// model learning of the second band, and phones whose L1 is the worse band).
+enum class FrequencyMode { kSingle, kDual, kL5 };
 
 struct MeasurementOptions {
   FrequencyMode frequency = FrequencyMode::kSingle;  // default chosen by measurement (docs/gnss.md)
@@ -113,10 +115,6 @@ struct MeasurementOptions {
   /// Keep the L1 code of a combined group's L1-only satellites (mixes IF and L1 in one clock
   /// group: the few-metre mean-ionosphere mismatch is not modelled). Default false: dropped.
   bool dual_keep_single = false;
-  // code noise model used for the IF variance factor (same form and values as SppOptions:
-  // sigma^2 = a + b 10^(-C/N0/10), Walker 2019 Sec. 2.3), evaluated per band's C/N0
-  double dual_var_a_m2 = 4.0;
-  double dual_var_b_m2 = 160000.0;
   double min_cn0_dbhz = 15.0;            // issue 7 / Walker 2019 Sec. 2.2: reject C/N0 < 15 dB-Hz
   double max_uncertainty = 1e6;         // uncertainties above this (e.g. 3.4e38 "unknown") reject the field
   double max_pr_sigma_m = 150.0;        // ReceivedSvTimeUncertainty * c above this: code unusable
@@ -153,7 +151,7 @@ inline constexpr double kIfBeta = kIfAlpha - 1.0;
 /// i.e. the IF code minus beta x the epoch's median L1-L5 difference. The median carries the
 /// receiver L1-L5 bias (and the satellites' mean group delay), so P_IF stays on the L1 receiver
 /// clock up to the group's median ionosphere (absorbed by the group's clock/ISB like the bias),
-/// and the satellite's own ionosphere and TGD/BGD are removed. var_scale = alpha^2 + beta^2 v5/v1.
+/// and the satellite's own ionosphere and TGD/BGD are removed (variance: noise_model.h iono_free_variance_m2).
 /// L1-only satellites of a combined group lose their code (counted) unless dual_keep_single.
 void combine_dual_frequency(std::vector<Measurement>& meas, const MeasurementOptions& opt, ExclusionCounts& excluded);
 

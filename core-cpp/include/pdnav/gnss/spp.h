@@ -13,15 +13,10 @@
 #include "pdnav/geo/samples.h"
 #include "pdnav/gnss/atmosphere.h"
 #include "pdnav/gnss/ephemeris.h"
+#include "pdnav/gnss/noise_model.h"
 #include "pdnav/gnss/types.h"
 
 namespace pdnav::gnss {
-
-/// Variance of a measurement from C/N0 (and elevation):
-///   sigma^2 = a / sin^2(el) + b * 10^(-C/N0 / 10)
-/// the SNR form of Walker 2019 Sec. 2.3 (sigma^2 = a + b 10^(-C/N0/10)) with the constant
-/// term mapped by elevation (RTKLIB-style elevation weighting) for code multipath.
-double cn0_elevation_variance(double a, double b, double cn0_dbhz, double el_rad);
 
 /// Upper quantile of the chi-square distribution (Wilson-Hilferty approximation, relative
 /// error < 3 % for dof >= 1 at P_fa 1e-3..0.05, erring high, i.e. slightly conservative).
@@ -36,8 +31,9 @@ enum class SppFde {
 
 struct SppOptions {
   double elevation_mask_deg = 10.0;     // Walker 2019 Sec. 2.2 (10 deg mask)
-  double code_var_a_m2 = 4.0;           // a of cn0_elevation_variance for code [m^2] (2 m at zenith, strong signal)
-  double code_var_b_m2 = 160000.0;      // b [m^2 (Hz)]: 4 m at 40 dB-Hz, 22 m at 25 dB-Hz (phone code noise)
+  // code variance a / sin^2(el) + b 10^(-C/N0/10) per constellation and band (Walker 2019
+  // Sec. 2.3 form; a, b learned from the shared data: noise_model.h, docs/gnss.md)
+  CodeNoiseModel code_noise;
   double fde_false_alarm = 1e-3;        // chi-square test probability (RAIM P_fa)
   int max_fde_exclusions = 4;           // stop excluding after this many satellites
   SppFde fde = SppFde::kSubsets;        // two 30-60 m multipath faults defeat kLargestResidual (tests)
@@ -64,9 +60,11 @@ struct SppObservation {
   double carrier_hz = 1575.42e6;
   SatState state;  // at transmit time, from EphemerisStore::state
   /// The code is the L1/L5 ionosphere-free combination (measurements.h): no Klobuchar and no
-  /// TGD/BGD (the combination removes both); its variance is var_scale x the L1 model.
+  /// TGD/BGD (the combination removes both); its variance is iono_free_variance_m2 from the L1
+  /// and L5 C/N0 (noise_model.h).
   bool iono_free = false;
-  double var_scale = 1.0;
+  double var_scale = 1.0;           // multiplies the model variance
+  double cn0_l5_dbhz = kNaN;        // the L5/E5a C/N0 of an iono_free code
 };
 
 struct SppSolution {
@@ -95,6 +93,30 @@ struct SppSolution {
 /// is the reception time of week for Klobuchar; `klob` may be null (no ionosphere model).
 SppSolution solve_spp(const std::vector<SppObservation>& obs, const geo::Ecef& initial,
                       double gps_tow_s, const KlobucharParams* klob, const SppOptions& opt);
+
+/// One code residual at a known receiver position (noise-model learning, noise_model.h).
+struct TruthResidual {
+  SatId sat;
+  double carrier_hz = 0.0;
+  double cn0_dbhz = 0.0;
+  double el_rad = 0.0;
+  double residual_m = 0.0;  // measured - modelled - receiver clock of its clock group
+  int group_size = 0;       // satellites of its clock group that epoch
+};
+
+struct TruthResidualOptions {
+  int min_group = 3;               // clock groups with fewer satellites are left out
+  bool estimate_height = false;    // the truth's height is unknown or biased: estimate an offset
+};
+
+/// Residuals of `obs` at the receiver position `truth`, with solve_spp's corrections (Sagnac,
+/// satellite clock and group delay, Klobuchar, Saastamoinen, elevation mask). The receiver
+/// clock of each clock group (and with estimate_height a height offset along the truth's up)
+/// is fitted by least absolute deviations (robust to multipath tails); the residuals are
+/// scaled by sqrt(N / (N - P)) for the P fitted unknowns.
+std::vector<TruthResidual> residuals_at_truth(const std::vector<SppObservation>& obs, const geo::Ecef& truth,
+                                              double gps_tow_s, const KlobucharParams* klob, const SppOptions& opt,
+                                              const TruthResidualOptions& ropt = {});
 
 /// The receiver-clock group of a system: QZSS shares GPS time (IS-QZSS-PNT 3.2: QZSST is
 /// steered to GPST and L1 C/A is interoperable), every other system has its own ISB.
