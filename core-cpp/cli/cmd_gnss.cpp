@@ -46,7 +46,7 @@ struct GnssArgs {
   int dual_min_sats = gnss::MeasurementOptions{}.dual_min_sats;
   double dual_min_fraction = gnss::MeasurementOptions{}.dual_min_fraction;
   bool dual_keep_single = gnss::MeasurementOptions{}.dual_keep_single;
-  std::string freq = gnss::MeasurementOptions{}.frequency == gnss::FrequencyMode::kDual ? "dual" : "single";
+  std::string freq = gnss::frequency_mode_name(gnss::MeasurementOptions{}.frequency);
   double kf_displacement_q_m2 = gnss::KalmanOptions{}.displacement_q_m2;
   double kf_fix_scale = gnss::KalmanOptions{}.fix_variance_scale;
   std::string dynamics = gnss::kf_dynamics_name(gnss::KalmanOptions{}.dynamics);
@@ -311,8 +311,9 @@ void run_gnss(const GnssArgs& a) {
   options.measurements.dual_min_fraction = a.dual_min_fraction;
   options.measurements.dual_keep_single = a.dual_keep_single;
   options.measurements.frequency = a.freq == "dual" ? gnss::FrequencyMode::kDual
-                                   : a.freq == "l5" ? gnss::FrequencyMode::kL5
-                                                    : gnss::FrequencyMode::kSingle;
+                                   : a.freq == "l5"   ? gnss::FrequencyMode::kL5
+                                   : a.freq == "best" ? gnss::FrequencyMode::kBest
+                                                      : gnss::FrequencyMode::kSingle;
   options.kalman.displacement_q_m2 = a.kf_displacement_q_m2;
   options.kalman.fix_variance_scale = a.kf_fix_scale;
   gnss::parse_kf_dynamics(a.dynamics, options.kalman.dynamics);  // validated by CLI11
@@ -398,8 +399,9 @@ void register_gnss(CLI::App& app) {
       ->check(CLI::Range(1, 3600));
   cmd->add_option("--freq", args->freq,
                   "single: L1/E1/B1 + Klobuchar; dual: L1/L5 (E1/E5a) ionosphere-free code per clock group "
-                  "where enough satellites track both bands (docs/gnss.md); l5: L5/E5a/B2a alone")
-      ->check(CLI::IsMember({"single", "dual", "l5"}));
+                  "where enough satellites track both bands (docs/gnss.md); l5: L5/E5a/B2a alone; best: per "
+                  "satellite L5/E5a where tracked, else L1 (a receiver clock per band)")
+      ->check(CLI::IsMember({"single", "dual", "l5", "best"}));
   cmd->add_option("--iono-window", args->iono_window_s,
                   "dual: averaging window of the IF ionosphere correction, s (0 = raw IF code)")
       ->check(CLI::Range(0.0, 1e5));

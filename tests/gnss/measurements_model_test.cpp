@@ -192,3 +192,49 @@ TEST(MeasurementsModel, EpochWithoutGpsTimeIsRejected) {
 
 }  // namespace
 }  // namespace pdnav::gnss
+
+namespace pdnav::gnss {
+namespace {
+
+// FrequencyMode::kBest: GPS has five satellites with L1 and L5 (moved to L5: code, Doppler
+// and carrier of the L5 row), Galileo two with E5a among five (fewer than dual_min_sats = 4:
+// the group stays on E1, its E5a rows are counted).
+TEST(MeasurementsModel, BestBandMovesAClockGroupWithEnoughL5CodesToL5) {
+  const std::int64_t rx = kWeek2200 + 345'678 * kNsPerS;
+  std::vector<GnssRawSample> rows;
+  auto add = [&](int constellation, int svid, double carrier_hz, double adr_m) {
+    GnssRawSample r = row_at(rx, constellation, svid, kGpsOk | state_bit::kGalE1c2ndCodeLock);
+    r.received_sv_time_nanos = (rx - kWeek2200) - kTravelNs - svid * 1'000'000;
+    r.carrier_frequency_hz = carrier_hz;
+    r.accumulated_delta_range_m = adr_m;
+    rows.push_back(r);
+  };
+  for (int sv = 1; sv <= 5; ++sv) {
+    add(1, sv, 1575.42e6, 100.0);
+    add(1, sv, 1176.45e6, 500.0);
+    add(6, sv, 1575.42e6, 100.0);
+    if (sv <= 2) add(6, sv, 1176.45e6, 500.0);
+  }
+  MeasurementOptions opt;
+  opt.frequency = FrequencyMode::kBest;
+  MeasurementEpoch ep;
+  ExclusionCounts ex;
+  ASSERT_TRUE(build_epoch(rows, opt, ep, ex));
+  ASSERT_EQ(ep.meas.size(), 10u);
+  for (const Measurement& m : ep.meas) {
+    const bool gps = m.sat.sys == Constellation::kGps;
+    EXPECT_EQ(l5_band(m.sat.sys, m.carrier_hz), gps) << m.sat.to_string();
+    EXPECT_EQ(m.adr_m, gps ? 500.0 : 100.0) << m.sat.to_string();
+    EXPECT_TRUE(m.code_ok()) << m.sat.to_string();
+  }
+  EXPECT_EQ(ex["best: L5/E5a signal used instead of L1"], 5);
+  EXPECT_EQ(ex["best: too few L5/E5a codes in the clock group (L1 kept)"], 2);
+  // single frequency: everything on L1
+  opt.frequency = FrequencyMode::kSingle;
+  MeasurementEpoch l1;
+  ASSERT_TRUE(build_epoch(rows, opt, l1, ex));
+  for (const Measurement& m : l1.meas) EXPECT_FALSE(l5_band(m.sat.sys, m.carrier_hz)) << m.sat.to_string();
+}
+
+}  // namespace
+}  // namespace pdnav::gnss

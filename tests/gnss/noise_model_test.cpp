@@ -100,5 +100,38 @@ TEST(NoiseModel, ResidualsAtTruthRecoverTheSimulatedNoiseOfEachSystem) {
   EXPECT_GT(biased.rms_m.at(Constellation::kGalileo), 3.0);
 }
 
+// FrequencyMode::kBest puts L1 and L5 codes of one system into one epoch: the L5 codes carry
+// the receiver's L1-L5 bias (2.35 km on the GSDC Pixel 5), which the SPP estimates as a clock
+// of its own per band.
+TEST(NoiseModel, SppSolvesOneReceiverClockPerBand) {
+  const geo::Ecef rx = geo::to_ecef(kRxGeo);
+  const auto sky = synthetic_sky(rx, 10, 77);
+  std::vector<SppObservation> obs;
+  for (std::size_t i = 0; i < sky.size(); ++i) {
+    SppObservation o;
+    o.sat = sky[i].sat;
+    o.cn0_dbhz = 40.0;
+    o.state = sky[i].state;
+    o.state.group_delay_s = 0.0;
+    const bool l5 = i % 2 == 1;
+    o.carrier_hz = l5 ? 1176.45e6 : 1575.42e6;
+    o.pseudorange_m = sagnac_range_m(o.state.pos.p_m, rx.p_m) + 30.0 + (l5 ? 2350.0 : 0.0) -
+                      kSpeedOfLight_mps * o.state.clock_bias_s;
+    obs.push_back(o);
+  }
+  SppOptions opt;
+  opt.ionosphere = false;
+  opt.troposphere = false;
+  const SppSolution s = solve_spp(obs, geo::Ecef(), 345600.0, nullptr, opt);
+  ASSERT_TRUE(s.ok) << s.reason;
+  EXPECT_LT((s.pos.p_m - rx.p_m).norm(), 0.01);
+  EXPECT_EQ(s.clock_system, Constellation::kGps);
+  EXPECT_EQ(s.clock_band, SignalBand::kL1);
+  EXPECT_NEAR(s.clock_m, 30.0, 0.01);
+  ASSERT_EQ(s.isb_l5_m.count(Constellation::kGps), 1u);
+  EXPECT_NEAR(s.isb_l5_m.at(Constellation::kGps), 2350.0, 0.01);
+  EXPECT_TRUE(s.isb_m.empty());
+}
+
 }  // namespace
 }  // namespace pdnav::gnss

@@ -49,6 +49,7 @@ struct GnssEngine::Impl {
   int last_sats_used = 0;
   bool have_clock_system = false;
   Constellation kf_clock_system = Constellation::kGps;
+  SignalBand kf_clock_band = SignalBand::kL1;
   std::string last_reason;
 
   void count(const std::string& reason, std::int64_t n = 1) { excluded[reason] += n; }
@@ -125,7 +126,7 @@ struct GnssEngine::Impl {
       if (!sat_state(m, ep.rx, st)) continue;
       if (m.code_ok()) {
         sm_in.push_back(SmoothingInput{m.sat, m.pseudorange_m, m.adr_ok() ? m.adr_m : kNaN, m.pr_rate_mps, m.iono_free,
-                                       m.pseudorange_l1_m});
+                                       m.pseudorange_l1_m, m.iono_free ? SignalBand::kL1 : signal_band(m.carrier_hz)});
         spp_obs.push_back(SppObservation{m.sat, m.pseudorange_m, m.cn0_dbhz, carrier_hz(m, st), st, m.iono_free, 1.0,
                                          m.iono_free ? m.cn0_l5_dbhz : kNaN});
       }
@@ -267,17 +268,18 @@ struct GnssEngine::Impl {
       // the SPP clock is the clock of its reference system (GPS when present); when that
       // system changes, the clock state jumps by an ISB: re-initialise the clock instead of
       // rejecting updates until the filter hard-resets
-      if (kf.initialized() && have_clock_system && spp.clock_system != kf_clock_system) {
+      if (kf.initialized() && have_clock_system && (spp.clock_system != kf_clock_system || spp.clock_band != kf_clock_band)) {
         count("kf: reference clock system changed (clock re-initialised)");
         kf.reset_clock(spp.clock_m, 1e12);
       }
       kf_clock_system = spp.clock_system;
+      kf_clock_band = spp.clock_band;
       have_clock_system = true;
       sol.clock_system = spp.clock_system;
       const bool was_initialized = kf.initialized();
       // R = the SPP covariance scaled by its a-posteriori variance factor chi2/dof (at least 1):
       // the a-priori C/N0 model does not know the multipath of a moving phone, the residuals do
-      const int dof = static_cast<int>(spp.used.size()) - 4 - static_cast<int>(spp.isb_m.size());
+      const int dof = static_cast<int>(spp.used.size()) - 4 - static_cast<int>(spp.isb_m.size() + spp.isb_l5_m.size());
       const double vf = opt.scale_fix_by_variance_factor && dof > 0 ? std::max(1.0, spp.chi2 / dof) : 1.0;
       const double since_fix_s = last_fix_gps_ns != 0 ? static_cast<double>(sol.gps_ns - last_fix_gps_ns) * 1e-9 : 1.0;
       last_fix_gps_ns = sol.gps_ns;

@@ -163,6 +163,31 @@ void drop_duplicates(std::vector<Measurement>& meas, ExclusionCounts& excluded) 
   meas.swap(out);
 }
 
+/// FrequencyMode::kBest: in a clock group with at least `min_sats` usable L5/E5a/B2a codes,
+/// every such satellite is measured on that band (code, Doppler, carrier); the others keep L1.
+/// A group with fewer L5 codes stays on L1: its L5 clock (the receiver's L1-L5 bias, one more
+/// unknown) would be fixed by too few satellites.
+void use_best_band(std::vector<Measurement>& meas, std::vector<Measurement>& l5, int min_sats,
+                   ExclusionCounts& excluded) {
+  drop_duplicates(l5, excluded);
+  std::map<Constellation, int> per_group;
+  for (const Measurement& s5 : l5) ++per_group[s5.sat.sys == Constellation::kQzss ? Constellation::kGps : s5.sat.sys];
+  for (const Measurement& s5 : l5) {
+    if (per_group[s5.sat.sys == Constellation::kQzss ? Constellation::kGps : s5.sat.sys] < min_sats) {
+      ++excluded["best: too few L5/E5a codes in the clock group (L1 kept)"];
+      continue;
+    }
+    auto it = std::find_if(meas.begin(), meas.end(), [&](const Measurement& o) { return o.sat == s5.sat; });
+    if (it == meas.end()) {
+      meas.push_back(s5);
+      ++excluded["best: L5/E5a signal without L1 (used)"];
+    } else {
+      *it = s5;
+      ++excluded["best: L5/E5a signal used instead of L1"];
+    }
+  }
+}
+
 bool supported(Constellation c) {
   return c == Constellation::kGps || c == Constellation::kGlonass || c == Constellation::kGalileo ||
          c == Constellation::kBeidou || c == Constellation::kQzss;
@@ -179,6 +204,15 @@ double median_of(std::vector<double> v) {
 }
 
 }  // namespace
+
+const char* frequency_mode_name(FrequencyMode m) {
+  switch (m) {
+    case FrequencyMode::kDual: return "dual";
+    case FrequencyMode::kL5: return "l5";
+    case FrequencyMode::kBest: return "best";
+    default: return "single";
+  }
+}
 
 bool l5_band(Constellation sys, double carrier_hz) {
   if (!std::isfinite(carrier_hz)) return false;
@@ -293,7 +327,8 @@ bool build_epoch(const std::vector<GnssRawSample>& rows, const MeasurementOption
                          ? static_cast<int>(c.leap_second) : geo::leap_seconds_at_gps_ns(out.rx.ns);
   const bool dual = opt.frequency == FrequencyMode::kDual;
   const bool l5_only = opt.frequency == FrequencyMode::kL5;
-  std::vector<Measurement> l5;  // second-band codes (dual mode)
+  const bool best = opt.frequency == FrequencyMode::kBest;
+  std::vector<Measurement> l5;  // second-band codes (dual mode) or measurements (best mode)
   for (const GnssRawSample& r : rows) {
     Measurement m;
     m.sat = SatId::from_android(r.constellation_type, r.svid);
@@ -304,7 +339,7 @@ bool build_epoch(const std::vector<GnssRawSample>& rows, const MeasurementOption
     if (m.sat.sys == Constellation::kGlonass && r.svid >= 93 && r.svid <= 106) m.glonass_channel = r.svid - 100;
     if (finite_and_small(r.carrier_frequency_hz, 1e10) && r.carrier_frequency_hz > 1e8) m.carrier_hz = r.carrier_frequency_hz;
     if (r.code_type.size() <= 4) m.code_type = r.code_type;
-    const bool second = dual && l5_band(m.sat.sys, m.carrier_hz);
+    const bool second = (dual || best) && l5_band(m.sat.sys, m.carrier_hz);
     if (l5_only && !l5_band(m.sat.sys, m.carrier_hz)) { ++excluded["signal: not L5/E5a/B2a (--freq l5)"]; continue; }
     if (!l5_only && !second && !l1_band(m.sat.sys, m.carrier_hz)) {
       ++excluded[dual ? "signal: neither L1/E1/B1 nor L5/E5a" : "signal: not L1/E1/B1 (one band used)"];
@@ -314,16 +349,21 @@ bool build_epoch(const std::vector<GnssRawSample>& rows, const MeasurementOption
     GpsTime rx;
     if (!receive_gps_time(r, rx)) { ++excluded["epoch: no GPS time (FullBiasNanos missing)"]; continue; }
     fill_code(r, rx, out.leap_seconds, opt, m, excluded);
-    if (second) {  // only the code of the second band is used (ADR/Doppler stay L1)
+    if (second && dual) {  // only the code of the second band is used (ADR/Doppler stay L1)
       if (m.code_ok()) l5.push_back(m);
       continue;
     }
     fill_rate(r, opt, m, excluded);
     fill_adr(r, opt, m, excluded);
+    if (second) {  // best: the whole L5 measurement replaces L1 below when its code is usable
+      if (m.code_ok()) l5.push_back(m);
+      continue;
+    }
     if (!m.code_ok() && !std::isfinite(m.pr_rate_mps) && !std::isfinite(m.adr_m)) continue;
     out.meas.push_back(m);
   }
   drop_duplicates(out.meas, excluded);
+  if (best) use_best_band(out.meas, l5, opt.dual_min_sats, excluded);
   if (dual) {
     drop_duplicates(l5, excluded);
     for (const Measurement& s5 : l5) {

@@ -18,7 +18,8 @@ double CodeSmoother::innovation(const SmoothingInput& in) const {
   const auto it = sats_.find(in.sat);
   if (it == sats_.end()) return std::nan("");
   const Sat& s = it->second;
-  if (!(s.epoch == epoch_ - 1 && dt_s_ > 0.0 && opt_.window_s > 0.0 && s.iono_free == in.iono_free)) return std::nan("");
+  if (!(s.epoch == epoch_ - 1 && dt_s_ > 0.0 && opt_.window_s > 0.0 && s.iono_free == in.iono_free && s.band == in.band))
+    return std::nan("");
   double delta = std::nan("");
   if (!carrier_broken_ && std::isfinite(in.adr_m) && std::isfinite(s.adr_m)) delta = in.adr_m - s.adr_m - clock_jump_m_;
   else if (std::isfinite(in.pr_rate_mps) && std::isfinite(s.pr_rate_mps))
@@ -76,9 +77,12 @@ std::vector<double> CodeSmoother::smooth_epoch(const std::vector<SmoothingInput>
 double CodeSmoother::smooth(const SmoothingInput& in, std::string* reason) {
   if (!std::isfinite(in.pseudorange_m)) return in.pseudorange_m;
   Sat& s = sats_[in.sat];
-  const bool continuous = s.epoch == epoch_ - 1 && dt_s_ > 0.0 && opt_.window_s > 0.0 && s.iono_free == in.iono_free;
+  const bool continuous =
+      s.epoch == epoch_ - 1 && dt_s_ > 0.0 && opt_.window_s > 0.0 && s.iono_free == in.iono_free && s.band == in.band;
   if (s.epoch == epoch_ - 1 && s.iono_free != in.iono_free && reason != nullptr)
     *reason = "smoothing: single/dual frequency switch (restarted)";
+  else if (s.epoch == epoch_ - 1 && s.band != in.band && reason != nullptr)
+    *reason = "smoothing: L1/L5 band switch (restarted)";
   double delta = std::nan("");
   if (continuous && !carrier_broken_ && std::isfinite(in.adr_m) && std::isfinite(s.adr_m)) {
     delta = in.adr_m - s.adr_m - clock_jump_m_;
@@ -101,6 +105,7 @@ double CodeSmoother::smooth(const SmoothingInput& in, std::string* reason) {
   s.pr_rate_mps = in.pr_rate_mps;
   s.epoch = epoch_;
   s.iono_free = in.iono_free;
+  s.band = in.band;
   return s.pr_sm_m;
 }
 

@@ -17,10 +17,18 @@ constexpr double kL1Hz = 1575.42e6;
 constexpr double kNearSurfaceMinM = 6.0e6;   // iterate is "on Earth" between these radii
 constexpr double kNearSurfaceMaxM = 7.0e6;
 
-/// Unknowns: x, y, z, clock of the reference system, one ISB per other system.
+/// A receiver clock: one per clock group and band (an L5 code has the receiver's L1-L5 bias).
+struct ClockKey {
+  Constellation sys = Constellation::kGps;
+  SignalBand band = SignalBand::kL1;
+  bool operator<(const ClockKey& o) const { return sys != o.sys ? sys < o.sys : band < o.band; }
+  bool operator==(const ClockKey& o) const { return sys == o.sys && band == o.band; }
+};
+
+/// Unknowns: x, y, z, clock of the reference, one ISB per other clock key.
 struct Layout {
-  Constellation ref = Constellation::kGps;
-  std::map<Constellation, int> isb_col;  // system -> column (>= 4)
+  ClockKey ref;
+  std::map<ClockKey, int> isb_col;  // clock key -> column (>= 4)
   int cols = 4;
 };
 
@@ -32,21 +40,28 @@ Constellation clock_group(Constellation sys) {
 
 namespace {
 
+ClockKey clock_key(const SppObservation& o) {
+  // an ionosphere-free code is on the L1 clock (measurements.h combine_dual_frequency)
+  return ClockKey{clock_group(o.sat.sys), o.iono_free ? SignalBand::kL1 : signal_band(o.carrier_hz)};
+}
+
 Layout make_layout(const std::vector<const SppObservation*>& obs) {
-  std::map<Constellation, int> count;
-  for (const auto* o : obs) ++count[clock_group(o->sat.sys)];
+  std::map<ClockKey, int> count;
+  for (const auto* o : obs) ++count[clock_key(*o)];
   Layout l;
-  l.ref = count.count(Constellation::kGps) ? Constellation::kGps : count.begin()->first;
-  for (const auto& [sys, n] : count) {
-    if (sys == l.ref) continue;
-    l.isb_col[sys] = l.cols++;
+  // GPS L1 when present (the clock the KF and the fusion layer follow), else GPS L5, else the first
+  const ClockKey gps_l1{Constellation::kGps, SignalBand::kL1}, gps_l5{Constellation::kGps, SignalBand::kL5};
+  l.ref = count.count(gps_l1) ? gps_l1 : count.count(gps_l5) ? gps_l5 : count.begin()->first;
+  for (const auto& [key, n] : count) {
+    if (key == l.ref) continue;
+    l.isb_col[key] = l.cols++;
   }
   return l;
 }
 
-int isb_col(const Layout& l, Constellation sys) {
-  const Constellation g = clock_group(sys);
-  return g == l.ref ? -1 : l.isb_col.at(g);
+int isb_col(const Layout& l, const SppObservation& o) {
+  const ClockKey k = clock_key(o);
+  return k == l.ref ? -1 : l.isb_col.at(k);
 }
 
 struct Row {
@@ -82,7 +97,7 @@ Row model_row(const SppObservation& o, const Eigen::VectorXd& x, const Layout& l
   }
   r.los = (sat - rx) / range;
   double clock = x(3);
-  if (isb_col(l, o.sat.sys) >= 0) clock += x(isb_col(l, o.sat.sys));
+  if (isb_col(l, o) >= 0) clock += x(isb_col(l, o));
   double atmo_m = 0.0;
   const double radius = rx.norm();
   if (radius > kNearSurfaceMinM && radius < kNearSurfaceMaxM) {
@@ -133,7 +148,7 @@ LsResult iterate_ls(const std::vector<const SppObservation*>& obs, const Layout&
       if (r.masked) continue;
       h.block<1, 3>(i, 0) = -r.los.transpose();
       h(i, 3) = 1.0;
-      if (isb_col(l, obs[i]->sat.sys) >= 0) h(i, isb_col(l, obs[i]->sat.sys)) = 1.0;
+      if (isb_col(l, *obs[i]) >= 0) h(i, isb_col(l, *obs[i])) = 1.0;
       y(i) = r.residual_m;
       w(i) = 1.0 / r.var_m2;
       ++used;
@@ -171,15 +186,15 @@ Eigen::VectorXd initial_state(const Layout& l, const geo::Ecef& initial) {
 /// Drops satellites whose system has a single satellite (it only determines its own ISB).
 std::vector<const SppObservation*> usable(const std::vector<SppObservation>& obs, const SppOptions& opt,
                                           std::map<std::string, std::int64_t>& excluded) {
-  std::map<Constellation, int> count;
-  for (const auto& o : obs) ++count[clock_group(o.sat.sys)];
+  std::map<ClockKey, int> count;
+  for (const auto& o : obs) ++count[clock_key(o)];
   std::vector<const SppObservation*> out;
   for (const auto& o : obs) {
     if (!std::isfinite(o.pseudorange_m) || !o.state.pos.p_m.allFinite() || !std::isfinite(o.cn0_dbhz)) {
       ++excluded["spp: non-finite input"];
       continue;
     }
-    if (opt.drop_single_sat_systems && count[clock_group(o.sat.sys)] == 1 && count.size() > 1) {
+    if (opt.drop_single_sat_systems && count[clock_key(o)] == 1 && count.size() > 1) {
       ++excluded["spp: single satellite of its system"];
       continue;
     }
@@ -197,7 +212,7 @@ bool fill_dop(const LsResult& ls, const std::vector<const SppObservation*>& obs,
     if (r.masked) continue;
     h.block<1, 3>(k, 0) = -r.los.transpose();
     h(k, 3) = 1.0;
-    if (isb_col(l, obs[i]->sat.sys) >= 0) h(k, isb_col(l, obs[i]->sat.sys)) = 1.0;
+    if (isb_col(l, *obs[i]) >= 0) h(k, isb_col(l, *obs[i])) = 1.0;
     ++k;
   }
   const Eigen::MatrixXd n_mat = h.topRows(k).transpose() * h.topRows(k);
@@ -218,8 +233,9 @@ SppSolution to_solution(const LsResult& ls, const std::vector<const SppObservati
   s.ok = true;
   s.pos = geo::Ecef(ls.x.head<3>());
   s.clock_m = ls.x(3);
-  s.clock_system = l.ref;
-  for (const auto& [sys, col] : l.isb_col) s.isb_m[sys] = ls.x(col);
+  s.clock_system = l.ref.sys;
+  s.clock_band = l.ref.band;
+  for (const auto& [key, col] : l.isb_col) (key.band == SignalBand::kL1 ? s.isb_m : s.isb_l5_m)[key.sys] = ls.x(col);
   s.pos_cov_ecef = ls.cov.topLeftCorner<3, 3>();
   s.clock_var_m2 = ls.cov(3, 3);
   s.iterations = ls.iterations;
@@ -257,7 +273,7 @@ std::vector<double> standardised_residuals(const LsResult& ls, const std::vector
     Eigen::VectorXd h = Eigen::VectorXd::Zero(l.cols);
     h.head<3>() = -r.los;
     h(3) = 1.0;
-    if (isb_col(l, obs[i]->sat.sys) >= 0) h(isb_col(l, obs[i]->sat.sys)) = 1.0;
+    if (isb_col(l, *obs[i]) >= 0) h(isb_col(l, *obs[i])) = 1.0;
     const double qvv = r.var_m2 - h.dot(ls.cov * h);
     t[i] = r.residual_m / std::sqrt(std::max(qvv, 1e-6 * r.var_m2));
   }
@@ -350,21 +366,23 @@ std::vector<TruthResidual> residuals_at_truth(const std::vector<SppObservation>&
   const Layout l = make_layout(all);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(l.cols);  // clocks 0: estimated below
   x.head<3>() = truth.p_m;
-  std::map<Constellation, int> count;
+  std::map<ClockKey, int> count;
   std::vector<Eigen::Vector3d> los;
+  std::vector<ClockKey> keys;
   for (const SppObservation* o : all) {
     const Row r = model_row(*o, x, l, gps_tow_s, klob, opt);
     if (r.masked || !std::isfinite(r.residual_m)) continue;
-    ++count[clock_group(o->sat.sys)];
+    ++count[clock_key(*o)];
     out.push_back(TruthResidual{o->sat, o->carrier_hz, o->cn0_dbhz, r.el_rad, r.residual_m, 0});
     los.push_back(r.los);
+    keys.push_back(clock_key(*o));
   }
   // unknowns: one clock per kept group, then the height offset (when estimated)
-  std::map<Constellation, int> col;
+  std::map<ClockKey, int> col;
   for (const auto& [g, n] : count) if (n >= std::max(2, ropt.min_group)) col.emplace(g, static_cast<int>(col.size()));
   const int p = static_cast<int>(col.size()) + (ropt.estimate_height ? 1 : 0);
   std::vector<std::size_t> rows;
-  for (std::size_t i = 0; i < out.size(); ++i) if (col.count(clock_group(out[i].sat.sys))) rows.push_back(i);
+  for (std::size_t i = 0; i < out.size(); ++i) if (col.count(keys[i])) rows.push_back(i);
   const int n = static_cast<int>(rows.size());
   if (col.empty() || n <= p) return {};
   const Eigen::Vector3d up = truth.p_m.normalized();
@@ -372,7 +390,7 @@ std::vector<TruthResidual> residuals_at_truth(const std::vector<SppObservation>&
   Eigen::VectorXd y(n), w = Eigen::VectorXd::Ones(n), e(n);
   for (int k = 0; k < n; ++k) {
     const TruthResidual& t = out[rows[static_cast<std::size_t>(k)]];
-    h(k, col.at(clock_group(t.sat.sys))) = 1.0;
+    h(k, col.at(keys[rows[static_cast<std::size_t>(k)]])) = 1.0;
     if (ropt.estimate_height) h(k, p - 1) = -los[rows[static_cast<std::size_t>(k)]].dot(up);
     y(k) = t.residual_m;
   }
@@ -397,10 +415,10 @@ std::vector<TruthResidual> residuals_at_truth(const std::vector<SppObservation>&
   std::vector<TruthResidual> kept;
   for (int k = 0; k < n; ++k) {
     TruthResidual t = out[rows[static_cast<std::size_t>(k)]];
-    const Constellation g = clock_group(t.sat.sys);
+    const ClockKey g = keys[rows[static_cast<std::size_t>(k)]];
     std::vector<double> others;
     for (int j = 0; j < n; ++j)
-      if (j != k && clock_group(out[rows[static_cast<std::size_t>(j)]].sat.sys) == g) others.push_back(yh(j));
+      if (j != k && keys[rows[static_cast<std::size_t>(j)]] == g) others.push_back(yh(j));
     const std::size_t m = others.size();
     std::nth_element(others.begin(), others.begin() + static_cast<std::ptrdiff_t>(m / 2), others.end());
     double clock = others[m / 2];

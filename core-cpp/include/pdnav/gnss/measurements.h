@@ -98,8 +98,11 @@ struct MeasurementEpoch {
 ///            group stays single frequency + Klobuchar: see combine_dual_frequency).
 /// kSingle: L1/E1/B1 code, Klobuchar; kDual: L1/L5 ionosphere-free per clock group; kL5: the
 /// L5/E5a/B2a signal alone (code, Doppler, carrier), Klobuchar scaled to its frequency (noise-
-/// model learning of the second band, and phones whose L1 is the worse band).
-enum class FrequencyMode { kSingle, kDual, kL5 };
+/// model learning of the second band); kBest: per satellite the L5/E5a/B2a signal where its
+/// code is usable, else L1 (one receiver clock per constellation and band in the SPP).
+enum class FrequencyMode { kSingle, kDual, kL5, kBest };
+/// "single", "dual", "l5", "best".
+const char* frequency_mode_name(FrequencyMode m);
 
 struct MeasurementOptions {
   FrequencyMode frequency = FrequencyMode::kSingle;  // default chosen by measurement (docs/gnss.md)
@@ -107,7 +110,7 @@ struct MeasurementOptions {
   // satellites, and at least dual_min_fraction of them, track L5/E5a. The receiver's L1-L5
   // bias (2.35 km GPS / 1.91 km Galileo on the GSDC Pixel 5) differs per group; mixing IF and
   // L1 codes in one clock group would need its own bias unknown, so the group is all-or-none.
-  int dual_min_sats = 4;
+  int dual_min_sats = 4;  // also kBest: fewest L5 codes for a clock group to move to L5
   double dual_min_fraction = 0.75;
   /// Satellites of a combined group whose L1-L5 difference is this far from the group median
   /// are dropped (an L5 multipath/tracking error): 20 m = 25 m of L1 ionosphere difference.

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "pdnav/gnss/noise_model.h"
 #include "pdnav/gnss/types.h"
 
 namespace pdnav::gnss {
@@ -44,6 +45,9 @@ struct SmoothingInput {
   /// averaged over iono_window_s before it is added to the L1 code: the ionosphere changes
   /// slowly, so this removes most of the 2.6x noise amplification of the IF combination.
   double pseudorange_l1_m = 0.0;
+  /// The band of the code and carrier (FrequencyMode::kBest switches a satellite between L1
+  /// and L5 when it gains or loses L5): a change restarts the satellite.
+  SignalBand band = SignalBand::kL1;
 };
 
 class CodeSmoother {
@@ -72,6 +76,7 @@ class CodeSmoother {
     double n = 0.0;
     std::int64_t epoch = -1;
     bool iono_free = false;
+    SignalBand band = SignalBand::kL1;
     double iono_corr_m = 0.0, iono_n = 0.0;  // averaged IF correction and its sample count
   };
   SmoothingOptions opt_;

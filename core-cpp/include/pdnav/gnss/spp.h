@@ -73,7 +73,9 @@ struct SppSolution {
   geo::Ecef pos;
   double clock_m = 0.0;                            // receiver clock of the reference system, c*dt
   Constellation clock_system = Constellation::kGps;
-  std::map<Constellation, double> isb_m;           // inter-system bias vs the reference system
+  SignalBand clock_band = SignalBand::kL1;         // band of the reference clock (L5 only without GPS L1)
+  std::map<Constellation, double> isb_m;           // inter-system bias vs the reference system (L1 band)
+  std::map<Constellation, double> isb_l5_m;        // the L5-band clocks (FrequencyMode::kBest) vs the reference
   Eigen::Matrix3d pos_cov_ecef = Eigen::Matrix3d::Identity();  // a priori weights, m^2
   double clock_var_m2 = 0.0;
   double gdop = 0.0, pdop = 0.0, hdop = 0.0, vdop = 0.0;
