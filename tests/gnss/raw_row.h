@@ -1,5 +1,5 @@
 // Hand-made GnssLogger Raw rows with known answers, for the measurement tests
-// (measurements_model, dual_frequency).
+// (measurements_model, dual_frequency, review_defects).
 #pragma once
 #include <cstdint>
 

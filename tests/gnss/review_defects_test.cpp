@@ -19,6 +19,7 @@
 #include "pdnav/gnss/spp.h"
 #include "pdnav/gnss/tdcp.h"
 #include "mountainview_log.h"
+#include "raw_row.h"
 #include "synthetic_sky.h"
 #include "test_data.h"
 
@@ -208,18 +209,10 @@ TEST(ReviewDefects, DuplicateSignalsResolvedByUsabilityAndAFixedCodeOrderNotStre
   // GPS G05 twice in one epoch: the stronger row has no decoded TOW (no code), the weaker is
   // usable -> the usable one is kept; then two usable rows: code C wins over a stronger X
   auto make = [](const char* code, double cn0, std::int64_t state) {
-    GnssRawSample r;
-    r.t_ns = 1;
-    r.time_nanos = 1'000'000'000;
-    r.full_bias_nanos = -1'300'000'000'000'000'000;
-    r.bias_nanos = 0.0;
-    r.constellation_type = 1;
-    r.svid = 5;
-    r.state = state;
-    r.cn0_dbhz = cn0;
+    const std::int64_t rx = 1'000'000'000 + 1'300'000'000'000'000'000;  // FullBiasNanos -1.3e18
+    GnssRawSample r = test::raw_row(1, 1'000'000'000, rx, /*GPS*/ 1, 5, state, cn0);
     r.code_type = code;
     r.carrier_frequency_hz = 1575.42e6;
-    const std::int64_t rx = r.time_nanos - r.full_bias_nanos;
     r.received_sv_time_nanos = (rx - 75'000'000) % (7 * 86400 * kNsPerS);
     r.pseudorange_rate_mps = 100.0;
     return r;
