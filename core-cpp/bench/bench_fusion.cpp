@@ -9,34 +9,16 @@
 #include <memory>
 #include <vector>
 
-#include <Eigen/Geometry>
 #include <benchmark/benchmark.h>
 
 #include "pdnav/fusion/navigator.h"
 #include "pdnav/geo/baro.h"
 #include "pdnav/terrain/dem.h"
+#include "walk_fixtures.h"
 
 namespace {
 
 using namespace pdnav;
-
-std::shared_ptr<const terrain::Dem> bench_dem() {
-  terrain::DemInfo info;
-  info.origin_lat_deg = 42.5;
-  info.origin_lon_deg = 1.5;
-  info.cols = info.rows = 401;
-  info.cell_m = 30.0;
-  info.x0_m = info.y0_m = -6000.0;
-  info.vertical_datum = "EGM96";
-  std::vector<float> v(static_cast<std::size_t>(info.cols) * info.rows);
-  for (int j = 0; j < info.rows; ++j)
-    for (int i = 0; i < info.cols; ++i) {
-      const double e = info.x0_m + i * info.cell_m, n = info.y0_m + j * info.cell_m;
-      v[static_cast<std::size_t>(j) * info.cols + i] =
-          static_cast<float>(1500 + 120 * std::sin(e / 700) * std::cos(n / 900) + 60 * std::sin((e + 2 * n) / 330));
-    }
-  return std::make_shared<const terrain::Dem>(terrain::Dem::from_grid(info, std::move(v)));
-}
 
 std::vector<Sample> session(const terrain::Dem& dem, double duration_s) {
   std::vector<Sample> out;
@@ -48,10 +30,6 @@ std::vector<Sample> session(const terrain::Dem& dem, double duration_s) {
   m.key = "StartLongitudeDegrees";
   m.value = "1.5";
   out.push_back(m);
-  Eigen::Matrix3d r0;
-  r0.col(0) = Eigen::Vector3d(1, 0, 0);
-  r0.col(1) = Eigen::Vector3d(0, 0, 1);
-  r0.col(2) = Eigen::Vector3d(0, -1, 0);
   const geo::LocalFrame frame(geo::Geodetic::from_deg(42.5, 1.5, 0.0));
   double e = 0, n = 0, heading = 0.3;
   TimeNs next_step = kNsPerS, next_fix = kNsPerS, next_baro = kNsPerS;
@@ -70,15 +48,7 @@ std::vector<Sample> session(const terrain::Dem& dem, double duration_s) {
       heading += 0.002;
       e += 0.7 * std::sin(heading);
       n += 0.7 * std::cos(heading);
-      const Eigen::Quaterniond q(Eigen::AngleAxisd(-heading, Eigen::Vector3d::UnitZ()).toRotationMatrix() * r0);
-      RotationVectorSample rv;
-      rv.t_ns = t;
-      rv.quat_xyzw = Eigen::Vector4d(q.x(), q.y(), q.z(), q.w());
-      rv.heading_accuracy_rad = 0.1;
-      out.push_back(rv);
-      StepDetectorSample sd;
-      sd.t_ns = t;
-      out.push_back(sd);
+      for (const Sample& s : test::step_events(t, t, test::chest_facing(heading))) out.push_back(s);
     }
     if (t >= next_baro) {
       next_baro += 200 * kNsPerMs;
@@ -91,14 +61,7 @@ std::vector<Sample> session(const terrain::Dem& dem, double duration_s) {
       next_fix += kNsPerS;
       if (ts < 1200.0 || ts > 1800.0) {  // a 10 minute outage
         const geo::Geodetic gd = frame.to_geodetic(geo::Enu(e + 2.0 * std::sin(ts / 40.0), n + 2.0 * std::cos(ts / 55.0), 0.0));
-        FixSample f;
-        f.t_ns = t;
-        f.provider = "GPS";
-        f.lat_deg = gd.lat_deg();
-        f.lon_deg = gd.lon_deg();
-        f.alt_m = 1500.0;
-        f.accuracy_m = 4.0;
-        out.push_back(f);
+        out.push_back(test::gps_fix(t, gd, 1500.0, 4.0));
       }
     }
   }
@@ -106,7 +69,7 @@ std::vector<Sample> session(const terrain::Dem& dem, double duration_s) {
 }
 
 void BM_FusedReplayOneHour500Particles(benchmark::State& state) {
-  const auto dem = bench_dem();
+  const auto dem = test::bench_hills_dem();
   const double duration_s = 3600.0;
   const std::vector<Sample> samples = session(*dem, duration_s);
   fusion::NavigatorConfig cfg;

@@ -61,13 +61,34 @@ pdnav::PositionFix fix_for(const std::shared_ptr<const WalkGraph>& g, const Rout
   return centre_fix(*g, 0.5 * (lo + hi));
 }
 
+/// Each benchmark's engine: the grid, room for 100 000 routes, and the fix whose initial route
+/// set holds about state.range(0) routes.
+struct Setup {
+  std::shared_ptr<const WalkGraph> graph;
+  RouteOptions options;
+  pdnav::PositionFix fix;
+};
+
+Setup setup(const benchmark::State& state) {
+  Setup b;
+  b.graph = grid_graph();
+  b.options.max_routes = 100000;
+  b.options.min_fix_sigma_m = 0.1;
+  b.fix = fix_for(b.graph, b.options, static_cast<double>(state.range(0)));
+  return b;
+}
+
+/// Items/s = updates fed; `routes` = mean live routes over them.
+void report(benchmark::State& state, std::int64_t n, double routes_sum) {
+  state.SetItemsProcessed(n);
+  state.counters["routes"] = n > 0 ? routes_sum / static_cast<double>(n) : 0.0;
+}
+
 void BM_RouteStep(benchmark::State& state) {
-  const auto target = static_cast<double>(state.range(0));
-  auto g = grid_graph();
-  RouteOptions opt;
-  opt.max_routes = 100000;
-  opt.min_fix_sigma_m = 0.1;
-  const pdnav::PositionFix fix = fix_for(g, opt, target);
+  const Setup b = setup(state);
+  const auto& g = b.graph;
+  const RouteOptions& opt = b.options;
+  const pdnav::PositionFix& fix = b.fix;
   RouteEngine engine(opt, g, 1);
   engine.feed(fix);
   const std::size_t initial = engine.route_count();
@@ -91,18 +112,15 @@ void BM_RouteStep(benchmark::State& state) {
       state.ResumeTiming();
     }
   }
-  state.SetItemsProcessed(n);
-  state.counters["routes"] = n > 0 ? routes_sum / static_cast<double>(n) : 0.0;
+  report(state, n, routes_sum);
 }
 BENCHMARK(BM_RouteStep)->Arg(10)->Arg(100)->Arg(1000);
 
 void BM_RouteTurn(benchmark::State& state) {
-  const auto target = static_cast<double>(state.range(0));
-  auto g = grid_graph();
-  RouteOptions opt;
-  opt.max_routes = 100000;
-  opt.min_fix_sigma_m = 0.1;
-  const pdnav::PositionFix fix = fix_for(g, opt, target);
+  const Setup b = setup(state);
+  const auto& g = b.graph;
+  const RouteOptions& opt = b.options;
+  const pdnav::PositionFix& fix = b.fix;
   double routes_sum = 0.0;
   std::int64_t n = 0;
   RouteEngine base(opt, g, 1);
@@ -118,8 +136,7 @@ void BM_RouteTurn(benchmark::State& state) {
     benchmark::DoNotOptimize(engine.route_count());
     ++n;
   }
-  state.SetItemsProcessed(n);
-  state.counters["routes"] = n > 0 ? routes_sum / static_cast<double>(n) : 0.0;
+  report(state, n, routes_sum);
 }
 BENCHMARK(BM_RouteTurn)->Arg(10)->Arg(100)->Arg(1000);
 

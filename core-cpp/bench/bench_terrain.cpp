@@ -13,6 +13,7 @@
 
 #include "pdnav/geo/baro.h"
 #include "pdnav/terrain/terrain_engine.h"
+#include "walk_fixtures.h"
 
 namespace {
 
@@ -20,24 +21,7 @@ using namespace pdnav;
 using namespace pdnav::terrain;
 
 std::shared_ptr<const Dem> bench_dem() {
-  // 12 x 12 km of hills at 30 m (the size of the Andorra eval tile).
-  static const auto dem = [] {
-    DemInfo info;
-    info.origin_lat_deg = 42.5;
-    info.origin_lon_deg = 1.5;
-    info.cols = info.rows = 401;
-    info.cell_m = 30.0;
-    info.x0_m = info.y0_m = -6000.0;
-    info.vertical_datum = "EGM96";
-    std::vector<float> v(static_cast<std::size_t>(info.cols) * info.rows);
-    for (int j = 0; j < info.rows; ++j)
-      for (int i = 0; i < info.cols; ++i) {
-        const double e = info.x0_m + i * info.cell_m, n = info.y0_m + j * info.cell_m;
-        v[static_cast<std::size_t>(j) * info.cols + i] =
-            static_cast<float>(1500 + 120 * std::sin(e / 700) * std::cos(n / 900) + 60 * std::sin((e + 2 * n) / 330));
-      }
-    return std::make_shared<const Dem>(Dem::from_grid(info, std::move(v)));
-  }();
+  static const auto dem = test::bench_hills_dem();
   return dem;
 }
 

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "pdnav/fusion/navigator.h"
+#include "walk_fixtures.h"
 
 namespace pdnav::fusion {
 namespace {
@@ -39,10 +40,6 @@ WalkResult walk(std::uint64_t seed, double outage_s = 180.0, double start_off_m 
   const double model_len = 0.415 * kDefaultUserHeightM;  // what the PDR reports
   const double true_len = model_len * 1.06;
   const double bias = 8.0 * kDegToRad;                   // the phone's heading error
-  Eigen::Matrix3d r0;
-  r0.col(0) = Eigen::Vector3d(1, 0, 0);
-  r0.col(1) = Eigen::Vector3d(0, 0, 1);
-  r0.col(2) = Eigen::Vector3d(0, -1, 0);
   const geo::LocalFrame frame(geo::Geodetic::from_deg(42.5, 1.5, 0.0));
   Eigen::Vector2d truth = Eigen::Vector2d::Zero();
   double heading = 0.4, next_turn_s = 40.0;
@@ -64,29 +61,14 @@ WalkResult walk(std::uint64_t seed, double outage_s = 180.0, double start_off_m 
     }
     truth += true_len * Eigen::Vector2d(std::sin(heading), std::cos(heading));
     const double shown_heading = heading + bias + 4.0 * kDegToRad * u(rng);
-    const Eigen::Quaterniond q(Eigen::AngleAxisd(-shown_heading, Eigen::Vector3d::UnitZ()).toRotationMatrix() * r0);
-    RotationVectorSample rv;
-    rv.t_ns = t - kNsPerMs;
-    rv.quat_xyzw = Eigen::Vector4d(q.x(), q.y(), q.z(), q.w());
-    rv.heading_accuracy_rad = 0.1;
-    nav.feed(rv);
-    StepDetectorSample sd;
-    sd.t_ns = t;
-    nav.feed(sd);
+    for (const Sample& s : test::step_events(t - kNsPerMs, t, test::chest_facing(shown_heading))) nav.feed(s);
     const bool outage = ts >= open_s && ts < open_s + outage_s;
     while (next_fix <= t) {
       const double tf = static_cast<double>(next_fix) * 1e-9;
       if (!outage) {
         const Eigen::Vector2d err(2.0 * std::sin(2 * kPi * tf / 53.0 + ph) + 2.0 * u(rng), 2.0 * std::cos(2 * kPi * tf / 67.0) + 2.0 * u(rng));
         const geo::Geodetic g = frame.to_geodetic(geo::Enu(truth.x() + err.x(), truth.y() + err.y(), 0.0));
-        FixSample f;
-        f.t_ns = next_fix;
-        f.provider = "GPS";
-        f.lat_deg = g.lat_deg();
-        f.lon_deg = g.lon_deg();
-        f.alt_m = 0.0;
-        f.accuracy_m = 4.0;
-        nav.feed(f);
+        nav.feed(test::gps_fix(next_fix, g, 0.0, 4.0));
       }
       next_fix += kNsPerS;
     }

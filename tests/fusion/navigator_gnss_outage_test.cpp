@@ -16,6 +16,7 @@
 #include "pdnav/fusion/navigator.h"
 #include "pdnav/io/log_reader.h"
 #include "test_data.h"
+#include "walk_fixtures.h"
 
 namespace pdnav::fusion {
 namespace {
@@ -207,21 +208,10 @@ TEST(NavigatorContrivedDisagreement, StepsNorthOnAStaticLogNeverJumpAbove3Sigma)
     last_t = std::max(last_t, sample_time_ns(s));
   }
   ASSERT_GE(first_raw, 0);
-  Eigen::Matrix3d r0;  // camera forward (-Z) north, as in navigator_height_test
-  r0.col(0) = Eigen::Vector3d(1, 0, 0);
-  r0.col(1) = Eigen::Vector3d(0, 0, 1);
-  r0.col(2) = Eigen::Vector3d(0, -1, 0);
-  const Eigen::Quaterniond q(r0);
+  const Eigen::Quaterniond q(test::chest_facing_north());
   std::vector<Sample> steps;
   for (TimeNs t = first_raw + 20 * kNsPerS; t < last_t; t += 550 * kNsPerMs) {
-    RotationVectorSample rv;
-    rv.t_ns = t - kNsPerMs;
-    rv.quat_xyzw = Eigen::Vector4d(q.x(), q.y(), q.z(), q.w());
-    rv.heading_accuracy_rad = 0.1;
-    steps.push_back(rv);
-    StepDetectorSample sd;
-    sd.t_ns = t;
-    steps.push_back(sd);
+    for (const Sample& s : test::step_events(t - kNsPerMs, t, q)) steps.push_back(s);
   }
   std::vector<Sample> merged;
   std::merge(log.begin(), log.end(), steps.begin(), steps.end(), std::back_inserter(merged),

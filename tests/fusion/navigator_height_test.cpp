@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "pdnav/fusion/navigator.h"
+#include "walk_fixtures.h"
 
 namespace pdnav::fusion {
 namespace {
@@ -24,21 +25,10 @@ double walked_m(NavigatorConfig cfg, const std::string& height_meta, std::string
   nav.feed(meta(t, "StartLongitudeDegrees", "1.5"));
   if (!height_meta.empty()) nav.feed(meta(t, "UserHeightMeters", height_meta));
   // chest mount, camera forward (-Z) pointing north: device X east, Y up, Z south
-  Eigen::Matrix3d r;
-  r.col(0) = Eigen::Vector3d(1, 0, 0);
-  r.col(1) = Eigen::Vector3d(0, 0, 1);
-  r.col(2) = Eigen::Vector3d(0, -1, 0);
-  const Eigen::Quaterniond q(r);
+  const Eigen::Quaterniond q(test::chest_facing_north());
   for (int k = 0; k < 100; ++k) {
     t += 550 * kNsPerMs;
-    RotationVectorSample rv;
-    rv.t_ns = t - kNsPerMs;
-    rv.quat_xyzw = Eigen::Vector4d(q.x(), q.y(), q.z(), q.w());
-    rv.heading_accuracy_rad = 0.1;
-    nav.feed(rv);
-    StepDetectorSample sd;
-    sd.t_ns = t;
-    nav.feed(sd);
+    for (const Sample& s : test::step_events(t - kNsPerMs, t, q)) nav.feed(s);
   }
   if (ignored != nullptr)
     for (const auto& [why, n] : nav.ignored()) *ignored += why + ";";

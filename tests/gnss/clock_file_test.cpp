@@ -12,14 +12,13 @@
 #include "pdnav/gnss/clock_file.h"
 #include "pdnav/gnss/ephemeris.h"
 #include "pdnav/gnss/sp3.h"
+#include "gps_calendar.h"
 #include "test_data.h"
 
 namespace pdnav::gnss {
 namespace {
 
-TimeNs gps(int h, int mi, double s) {
-  return static_cast<TimeNs>(std::llround(geo::calendar_to_epoch_seconds(2021, 4, 28, h, mi, s) * 1e9));
-}
+TimeNs gps(int h, int mi, double s) { return test::gps_calendar_ns(2021, 4, 28, h, mi, s); }
 
 TEST(ClockFile, ReadsTheHandWrittenFixture) {
   const ClockFile f = read_rinex_clock_file(test::test_data("gnss/clock_3_04_handwritten.clk"));

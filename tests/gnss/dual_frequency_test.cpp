@@ -12,6 +12,7 @@
 #include "pdnav/gnss/solver_smoothing.h"
 #include "pdnav/gnss/solver_synthetic.h"
 #include "pdnav/gnss/spp.h"
+#include "raw_row.h"
 
 namespace pdnav::gnss {
 namespace {
@@ -169,19 +170,9 @@ TEST(DualFrequency, L5OutlierLosesItsCode) {
 }
 
 GnssRawSample raw(int svid, double carrier_hz, std::int64_t sv_time_ns, std::int64_t rx_gps_ns) {
-  GnssRawSample r;
-  r.t_ns = 1'000'000'000;
-  r.time_nanos = 2'000'000'000'000;
-  r.full_bias_nanos = r.time_nanos - rx_gps_ns;
-  r.bias_nanos = 0.0;
-  r.time_offset_nanos = 0.0;
-  r.hardware_clock_discontinuity_count = 0;
-  r.constellation_type = 1;  // GPS
-  r.svid = svid;
-  r.state = state_bit::kCodeLock | state_bit::kTowDecoded;
-  r.cn0_dbhz = 35.0;
+  GnssRawSample r = test::raw_row(1'000'000'000, 2'000'000'000'000, rx_gps_ns, /*GPS*/ 1, svid,
+                                  state_bit::kCodeLock | state_bit::kTowDecoded, 35.0);
   r.received_sv_time_nanos = sv_time_ns;
-  r.received_sv_time_uncertainty_nanos = 10;
   r.carrier_frequency_hz = carrier_hz;
   r.pseudorange_rate_mps = 10.0;
   r.pseudorange_rate_uncertainty_mps = 0.1;

@@ -10,28 +10,13 @@
 
 #include "pdnav/gnss/gnss_engine.h"
 #include "pdnav/gnss/solver_metrics.h"
-#include "pdnav/io/log_reader.h"
+#include "mountainview_log.h"
 #include "test_data.h"
 
 namespace pdnav::gnss {
 namespace {
 
 const geo::Geodetic kTruth = geo::Geodetic::from_deg(37.422578, -122.081678, -28.0);
-
-std::vector<GnssRawSample> read_raw() {
-  std::vector<GnssRawSample> rows;
-  io::LogReader reader(test::shared_data("gnss-mountainview/pseudoranges_log_2016_08_22_14_45_50.txt"));
-  Sample s;
-  while (reader.next(s))
-    if (const auto* raw = std::get_if<GnssRawSample>(&s)) rows.push_back(*raw);
-  return rows;
-}
-
-std::shared_ptr<const EphemerisStore> nav() {
-  auto store = std::make_shared<EphemerisStore>();
-  store->load_rinex_nav(test::shared_data("gnss-mountainview/hour2350.16n"));
-  return store;
-}
 
 void expect_finite(const std::vector<EpochSolution>& sols) {
   for (const auto& s : sols) {
@@ -51,7 +36,7 @@ std::vector<EpochSolution> finish(GnssEngine& engine) {
 }
 
 TEST(EngineRobustness, ClockDiscontinuityResetsTdcpAndKeepsAccuracy) {
-  auto rows = read_raw();
+  auto rows = test::mountainview_raw();
   ASSERT_GT(rows.size(), 4000u);
   const std::int64_t t_mid = rows[rows.size() / 2].time_nanos;
   for (auto& r : rows) {
@@ -62,7 +47,7 @@ TEST(EngineRobustness, ClockDiscontinuityResetsTdcpAndKeepsAccuracy) {
       r.accumulated_delta_range_m += 777.0; // carrier restarted
     }
   }
-  GnssEngine engine(GnssOptions{}, nav(), 1);
+  GnssEngine engine(GnssOptions{}, test::mountainview_nav(), 1);
   for (const auto& r : rows) engine.feed(r);
   const auto sols = finish(engine);
   EXPECT_EQ(engine.exclusions().at("clock: hardware clock discontinuity (TDCP and KF clock reset)"), 1);
@@ -75,7 +60,7 @@ TEST(EngineRobustness, FullBiasJumpingAcrossTheInt64RangeIsNotLinked) {
   // Fuzz finding (fuzz_navigator, 2026-11-23): consecutive epochs with FullBiasNanos of
   // -1.16e18 and +8.39e18 overflowed the int64 difference (UBSan in the asan/fuzz builds).
   // The epochs must simply not be linked (no TDCP / smoothing across them), never wrap.
-  auto rows = read_raw();
+  auto rows = test::mountainview_raw();
   std::vector<std::int64_t> epochs;
   for (const auto& r : rows)
     if (epochs.empty() || r.time_nanos != epochs.back()) epochs.push_back(r.time_nanos);
@@ -84,7 +69,7 @@ TEST(EngineRobustness, FullBiasJumpingAcrossTheInt64RangeIsNotLinked) {
     if (r.time_nanos == epochs[10]) r.full_bias_nanos = -1155938064663285906;
     if (r.time_nanos == epochs[11]) r.full_bias_nanos = 8387194961890077011;
   }
-  GnssEngine engine(GnssOptions{}, nav(), 1);
+  GnssEngine engine(GnssOptions{}, test::mountainview_nav(), 1);
   for (const auto& r : rows) engine.feed(r);
   const auto sols = finish(engine);
   EXPECT_GE(engine.exclusions().at("epoch: gap or time going backwards (no TDCP)"), 1);
@@ -92,7 +77,7 @@ TEST(EngineRobustness, FullBiasJumpingAcrossTheInt64RangeIsNotLinked) {
 }
 
 TEST(EngineRobustness, MalformedValuesAreCountedNeverNaN) {
-  auto rows = read_raw();
+  auto rows = test::mountainview_raw();
   const double inf = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < rows.size(); i += 7) {
     GnssRawSample& r = rows[i];
@@ -106,7 +91,7 @@ TEST(EngineRobustness, MalformedValuesAreCountedNeverNaN) {
   }
   GnssRawSample no_clock = rows[10];
   no_clock.time_nanos = kMissingInt;
-  GnssEngine engine(GnssOptions{}, nav(), 1);
+  GnssEngine engine(GnssOptions{}, test::mountainview_nav(), 1);
   engine.feed(no_clock);
   for (const auto& r : rows) engine.feed(r);
   const auto sols = finish(engine);
@@ -121,9 +106,9 @@ TEST(EngineRobustness, MalformedValuesAreCountedNeverNaN) {
 }
 
 TEST(EngineRobustness, FewerThanFourSatellitesCoastsThenLost) {
-  const auto rows = read_raw();
+  const auto rows = test::mountainview_raw();
   const std::int64_t t0 = rows.front().time_nanos;
-  GnssEngine engine(GnssOptions{}, nav(), 1);
+  GnssEngine engine(GnssOptions{}, test::mountainview_nav(), 1);
   // first 100 s normal, then only GPS PRNs 5, 12, 21 (3 satellites) for the rest
   const std::set<int> three = {5, 12, 21};
   for (const auto& r : rows) {
@@ -145,7 +130,7 @@ TEST(EngineRobustness, FewerThanFourSatellitesCoastsThenLost) {
 }
 
 TEST(EngineRobustness, NoEphemerisMeansNoFixAndACountedReason) {
-  const auto rows = read_raw();
+  const auto rows = test::mountainview_raw();
   GnssEngine engine(GnssOptions{}, nullptr, 1);
   for (std::size_t i = 0; i < 500; ++i) engine.feed(rows[i]);
   engine.flush();

@@ -9,6 +9,7 @@
 #include "pdnav/geo/time.h"
 #include "pdnav/gnss/ephemeris.h"
 #include "pdnav/gnss/rinex.h"
+#include "gps_calendar.h"
 #include "test_data.h"
 
 namespace pdnav::gnss {
@@ -16,10 +17,6 @@ namespace {
 
 const char* kBrdm = "gnss-orbits-2023-073/BRDM00DLR_S_20230730000_01D_MN.rnx";
 const char* kHour = "gnss-mountainview/hour2350.16n";
-
-TimeNs gps_ns_of(int y, int mo, int d, int h, int mi, double s) {
-  return static_cast<TimeNs>(std::llround(geo::calendar_to_epoch_seconds(y, mo, d, h, mi, s) * 1e9));
-}
 
 /// Position of `sat` at `t` from the record with reference time `ref` only.
 template <typename Eph>
@@ -99,7 +96,7 @@ TEST(EphemerisStore, BeidouGeoSatellitesStayGeostationary) {
     double lon0 = 0;
     for (int minute = 0; minute <= 120; minute += 15) {
       std::string why;
-      const auto s = store.state(SatId{Constellation::kBeidou, prn}, gps_ns_of(2023, 3, 14, 0, minute, 0.0), &why);
+      const auto s = store.state(SatId{Constellation::kBeidou, prn}, test::gps_calendar_ns(2023, 3, 14, 0, minute, 0.0), &why);
       ASSERT_TRUE(s) << why;
       const double r = s->pos.p_m.norm();
       EXPECT_NEAR(r, 42164e3, 30e3);
@@ -130,7 +127,7 @@ TEST(EphemerisStore, BeidouGeoSatellitesStayGeostationary) {
 TEST(EphemerisStore, ReasonsForMissingStaleUnsupportedAndUnhealthy) {
   EphemerisStore store;
   store.load_rinex_nav(test::shared_data(kBrdm));
-  const TimeNs t = gps_ns_of(2023, 3, 14, 0, 5, 0.0);
+  const TimeNs t = test::gps_calendar_ns(2023, 3, 14, 0, 5, 0.0);
   std::string why;
   EXPECT_TRUE(store.state(SatId{Constellation::kGps, 1}, t, &why)) << why;
   EXPECT_FALSE(store.state(SatId{Constellation::kGps, 30}, t, &why));

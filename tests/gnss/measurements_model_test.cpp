@@ -7,6 +7,7 @@
 
 #include "pdnav/geo/time.h"
 #include "pdnav/gnss/measurements.h"
+#include "raw_row.h"
 
 namespace pdnav::gnss {
 namespace {
@@ -17,18 +18,7 @@ const std::int64_t kWeek2200 = std::int64_t{2200} * geo::kNsPerWeek;
 
 /// A row whose receive time (GPS) is rx_gps_ns.
 GnssRawSample row_at(std::int64_t rx_gps_ns, int constellation, int svid, std::int64_t state) {
-  GnssRawSample r;
-  r.t_ns = 5'000'000'000;
-  r.time_nanos = 1'000'000'000'000;
-  r.full_bias_nanos = r.time_nanos - rx_gps_ns;
-  r.bias_nanos = 0.0;
-  r.time_offset_nanos = 0.0;
-  r.hardware_clock_discontinuity_count = 0;
-  r.constellation_type = constellation;
-  r.svid = svid;
-  r.state = state;
-  r.cn0_dbhz = 40.0;
-  r.received_sv_time_uncertainty_nanos = 10;
+  GnssRawSample r = test::raw_row(5'000'000'000, 1'000'000'000'000, rx_gps_ns, constellation, svid, state, 40.0);
   r.pseudorange_rate_mps = 100.0;
   r.pseudorange_rate_uncertainty_mps = 0.05;
   r.accumulated_delta_range_state = adr_bit::kValid;

@@ -7,13 +7,10 @@
 #include "pdnav/geo/time.h"
 #include "pdnav/gnss/ephemeris.h"
 #include "pdnav/gnss/rinex.h"
+#include "gps_calendar.h"
 
 namespace pdnav::gnss {
 namespace {
-
-TimeNs cal_ns(int y, int mo, int d, int h, int mi, double s) {
-  return static_cast<TimeNs>(std::llround(geo::calendar_to_epoch_seconds(y, mo, d, h, mi, s) * 1e9));
-}
 
 RinexNavData parse(const std::string& text) {
   std::istringstream in(text);
@@ -70,15 +67,15 @@ TEST(OrbitTime, GlonassUtcEpochsAcrossTheEnd2016LeapSecond) {
   const RinexNavData nav = parse(std::string(kHeader3) + glonass_record("2016 12 31 23 45 00") +
                                  glonass_record("2017 01 01 00 15 00"));
   ASSERT_EQ(nav.glonass.size(), 2u);
-  EXPECT_EQ(nav.glonass[0].tb_gps_ns, cal_ns(2016, 12, 31, 23, 45, 17.0));
-  EXPECT_EQ(nav.glonass[1].tb_gps_ns, cal_ns(2017, 1, 1, 0, 15, 18.0));
+  EXPECT_EQ(nav.glonass[0].tb_gps_ns, test::gps_calendar_ns(2016, 12, 31, 23, 45, 17.0));
+  EXPECT_EQ(nav.glonass[1].tb_gps_ns, test::gps_calendar_ns(2017, 1, 1, 0, 15, 18.0));
   EXPECT_EQ(nav.glonass[1].tb_gps_ns - nav.glonass[0].tb_gps_ns, 1801 * kNsPerS);
   // Across the UTC day boundary the nearest record is chosen by GPS time: at 00:05:00 GPST
   // the 00:15 UTC record (10 min 18 s away) wins over the 23:45 UTC one (19 min 43 s away).
   EphemerisStore store;
   for (const auto& g : nav.glonass) store.add(g);
   std::string why;
-  const auto s = store.state(SatId{Constellation::kGlonass, 1}, cal_ns(2017, 1, 1, 0, 5, 0.0), &why);
+  const auto s = store.state(SatId{Constellation::kGlonass, 1}, test::gps_calendar_ns(2017, 1, 1, 0, 5, 0.0), &why);
   ASSERT_TRUE(s) << why;
   EXPECT_EQ(s->toe_gps_ns, nav.glonass[1].tb_gps_ns);
   EXPECT_EQ(s->glonass_channel, 1);

@@ -5,7 +5,6 @@
 // does not restart the smoother; the GSDC SP3 header with 116 satellites is read whole and the
 // precise state agrees with the broadcast one.
 #include <cmath>
-#include <map>
 #include <memory>
 #include <vector>
 
@@ -19,7 +18,9 @@
 #include "pdnav/gnss/sp3.h"
 #include "pdnav/gnss/spp.h"
 #include "pdnav/gnss/tdcp.h"
-#include "pdnav/io/log_reader.h"
+#include "mountainview_log.h"
+#include "raw_row.h"
+#include "synthetic_sky.h"
 #include "test_data.h"
 
 namespace pdnav::gnss {
@@ -27,36 +28,12 @@ namespace {
 
 const geo::Ecef kRx = geo::to_ecef(geo::Geodetic::from_deg(37.4, -122.1, 10.0));
 
-SppOptions plain() {
-  SppOptions o;
-  o.ionosphere = false;
-  o.troposphere = false;
-  return o;
-}
-
-std::vector<SppObservation> observe(const std::vector<SyntheticSat>& sky, double clock_m,
-                                    const std::map<Constellation, double>& isb = {}) {
-  std::vector<SppObservation> obs;
-  for (const auto& s : sky) {
-    SppObservation o;
-    o.sat = s.sat;
-    o.cn0_dbhz = 40.0;
-    o.carrier_hz = default_carrier_hz(s.sat.sys);
-    o.state = s.state;
-    const auto it = isb.find(s.sat.sys);
-    o.pseudorange_m = sagnac_range_m(s.state.pos.p_m, kRx.p_m) + clock_m + (it == isb.end() ? 0.0 : it->second) -
-                      kSpeedOfLight_mps * (s.state.clock_bias_s - s.state.group_delay_s);
-    obs.push_back(o);
-  }
-  return obs;
-}
-
 TEST(ReviewDefects, QzssSharesTheGpsClock) {
   // 4 GPS + 1 QZSS: with its own ISB the lone QZSS satellite would be dropped (or cost a
   // degree of freedom); sharing GPS time it is used and the fix has 1 degree of freedom.
   auto sky = synthetic_sky(kRx, 5, 3);
   sky[4].sat = SatId{Constellation::kQzss, 2};
-  const SppSolution s = solve_spp(observe(sky, 100.0), geo::Ecef(), 0.0, nullptr, plain());
+  const SppSolution s = solve_spp(test::observe(sky, kRx, 100.0), geo::Ecef(), 0.0, nullptr, test::no_atmosphere());
   ASSERT_TRUE(s.ok) << s.reason;
   EXPECT_EQ(s.used.size(), 5u);
   EXPECT_EQ(s.isb_m.count(Constellation::kQzss), 0u);
@@ -65,9 +42,9 @@ TEST(ReviewDefects, QzssSharesTheGpsClock) {
 }
 
 TEST(ReviewDefects, SppNotOkWhenTheResidualTestFailsAtLowRedundancy) {
-  auto obs = observe(synthetic_sky(kRx, 5, 4), 0.0);  // 1 degree of freedom: nothing to exclude
+  auto obs = test::observe(synthetic_sky(kRx, 5, 4), kRx, 0.0);  // 1 degree of freedom: nothing to exclude
   obs[2].pseudorange_m += 300.0;
-  const SppSolution s = solve_spp(obs, geo::Ecef(), 0.0, nullptr, plain());
+  const SppSolution s = solve_spp(obs, geo::Ecef(), 0.0, nullptr, test::no_atmosphere());
   EXPECT_FALSE(s.ok);
   EXPECT_NE(s.reason.find("residual test failed"), std::string::npos) << s.reason;
 }
@@ -75,29 +52,20 @@ TEST(ReviewDefects, SppNotOkWhenTheResidualTestFailsAtLowRedundancy) {
 TEST(ReviewDefects, BeidouB1cIsNotCorrectedWithTheB1iGroupDelay) {
   auto sky = synthetic_sky(kRx, 8, 5, {Constellation::kBeidou});
   for (auto& s : sky) s.state.group_delay_s = 20e-9;  // TGD1 (B1I): 6 m
-  auto obs = observe(sky, 0.0);
+  auto obs = test::observe(sky, kRx, 0.0);
   // B1C (1575.42 MHz): the true observable has no TGD1 in it
   for (auto& o : obs) {
     o.carrier_hz = 1575.42e6;
     o.pseudorange_m -= kSpeedOfLight_mps * o.state.group_delay_s;
   }
-  const SppSolution s = solve_spp(obs, geo::Ecef(), 0.0, nullptr, plain());
+  const SppSolution s = solve_spp(obs, geo::Ecef(), 0.0, nullptr, test::no_atmosphere());
   ASSERT_TRUE(s.ok) << s.reason;
   EXPECT_NEAR(s.clock_m, 0.0, 1e-3);  // TGD1 applied would put 6 m into the clock
   // and B1I (1561.098 MHz) still gets TGD1
-  auto b1i = observe(sky, 0.0);
-  const SppSolution t = solve_spp(b1i, geo::Ecef(), 0.0, nullptr, plain());
+  auto b1i = test::observe(sky, kRx, 0.0);
+  const SppSolution t = solve_spp(b1i, geo::Ecef(), 0.0, nullptr, test::no_atmosphere());
   ASSERT_TRUE(t.ok);
   EXPECT_NEAR(t.clock_m, 0.0, 1e-3);
-}
-
-std::vector<GnssRawSample> read_raw() {
-  std::vector<GnssRawSample> rows;
-  io::LogReader reader(test::shared_data("gnss-mountainview/pseudoranges_log_2016_08_22_14_45_50.txt"));
-  Sample s;
-  while (reader.next(s))
-    if (const auto* raw = std::get_if<GnssRawSample>(&s)) rows.push_back(*raw);
-  return rows;
 }
 
 std::vector<std::vector<GnssRawSample>> epochs_of(const std::vector<GnssRawSample>& rows) {
@@ -109,15 +77,9 @@ std::vector<std::vector<GnssRawSample>> epochs_of(const std::vector<GnssRawSampl
   return out;
 }
 
-std::shared_ptr<const EphemerisStore> mv_nav() {
-  auto store = std::make_shared<EphemerisStore>();
-  store->load_rinex_nav(test::shared_data("gnss-mountainview/hour2350.16n"));
-  return store;
-}
-
 TEST(ReviewDefects, FeedEpochProcessesTheEpochAtOnce) {
-  const auto eps = epochs_of(read_raw());
-  GnssEngine engine(GnssOptions{}, mv_nav(), 1);
+  const auto eps = epochs_of(test::mountainview_raw());
+  GnssEngine engine(GnssOptions{}, test::mountainview_nav(), 1);
   for (std::size_t i = 0; i < 20; ++i) {
     engine.feed_epoch(eps[i]);
     const auto sols = engine.take_solutions();
@@ -139,8 +101,8 @@ TEST(ReviewDefects, KfClockReinitialisedWhenTheReferenceSystemChanges) {
     std::vector<SyntheticSat> now;
     for (const auto& s : sky)
       if (!(k >= 20 && k < 25 && s.sat.sys == Constellation::kGps)) now.push_back(s);
-    const SppSolution s = solve_spp(observe(now, 50.0, {{Constellation::kGalileo, gal_isb}}), geo::Ecef(), 0.0,
-                                    nullptr, plain());
+    const SppSolution s = solve_spp(test::observe(now, kRx, 50.0, {{Constellation::kGalileo, gal_isb}}), geo::Ecef(),
+                                    0.0, nullptr, test::no_atmosphere());
     ASSERT_TRUE(s.ok) << s.reason;
     if (kf.initialized()) kf.predict(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity() * 1e-4, 0.0, 1.0);
     if (kf.initialized() && last != Constellation::kUnknown && s.clock_system != last) {
@@ -247,18 +209,10 @@ TEST(ReviewDefects, DuplicateSignalsResolvedByUsabilityAndAFixedCodeOrderNotStre
   // GPS G05 twice in one epoch: the stronger row has no decoded TOW (no code), the weaker is
   // usable -> the usable one is kept; then two usable rows: code C wins over a stronger X
   auto make = [](const char* code, double cn0, std::int64_t state) {
-    GnssRawSample r;
-    r.t_ns = 1;
-    r.time_nanos = 1'000'000'000;
-    r.full_bias_nanos = -1'300'000'000'000'000'000;
-    r.bias_nanos = 0.0;
-    r.constellation_type = 1;
-    r.svid = 5;
-    r.state = state;
-    r.cn0_dbhz = cn0;
+    const std::int64_t rx = 1'000'000'000 + 1'300'000'000'000'000'000;  // FullBiasNanos -1.3e18
+    GnssRawSample r = test::raw_row(1, 1'000'000'000, rx, /*GPS*/ 1, 5, state, cn0);
     r.code_type = code;
     r.carrier_frequency_hz = 1575.42e6;
-    const std::int64_t rx = r.time_nanos - r.full_bias_nanos;
     r.received_sv_time_nanos = (rx - 75'000'000) % (7 * 86400 * kNsPerS);
     r.pseudorange_rate_mps = 100.0;
     return r;

@@ -7,6 +7,7 @@
 #include "pdnav/geo/time.h"
 #include "pdnav/gnss/ephemeris.h"
 #include "pdnav/gnss/rinex.h"
+#include "gps_calendar.h"
 #include "test_data.h"
 
 namespace pdnav::gnss {
@@ -14,10 +15,6 @@ namespace {
 
 const char* kBrdm = "gnss-orbits-2023-073/BRDM00DLR_S_20230730000_01D_MN.rnx";
 const char* kHour = "gnss-mountainview/hour2350.16n";
-
-TimeNs cal_ns(int y, int mo, int d, int h, int mi, double s) {
-  return static_cast<TimeNs>(std::llround(geo::calendar_to_epoch_seconds(y, mo, d, h, mi, s) * 1e9));
-}
 
 RinexNavData parse(const std::string& text) {
   std::istringstream in(text);
@@ -78,7 +75,7 @@ TEST(RinexNav, Rinex3MixedFileCountsAndTimeScales) {
   EXPECT_DOUBLE_EQ(nav.klobuchar->beta[3], 1.3107e+05);
   for (const auto& k : nav.kepler) {
     if (k.sat.to_string() == "C01") {  // BDT epoch 00:00:00 = GPST 00:00:14
-      EXPECT_EQ(k.toc_gps_ns, cal_ns(2023, 3, 14, 0, 0, 14.0));
+      EXPECT_EQ(k.toc_gps_ns, test::gps_calendar_ns(2023, 3, 14, 0, 0, 14.0));
       EXPECT_TRUE(k.bds_geo);
       break;
     }
@@ -94,7 +91,7 @@ TEST(RinexNav, Rinex3MixedFileCountsAndTimeScales) {
   // GLONASS: RINEX epoch is UTC; 18 leap seconds in 2023.
   const GlonassEphemeris& r01 = nav.glonass.front();
   EXPECT_EQ(r01.sat.to_string(), "R01");
-  EXPECT_EQ(r01.tb_gps_ns, cal_ns(2023, 3, 14, 0, 15, 18.0));
+  EXPECT_EQ(r01.tb_gps_ns, test::gps_calendar_ns(2023, 3, 14, 0, 15, 18.0));
   EXPECT_EQ(r01.channel, 1);
   EXPECT_DOUBLE_EQ(r01.pos_m.x(), 5.763751464844e+06);
   EXPECT_DOUBLE_EQ(r01.acc_mps2.y(), -9.313225746155e-07);
@@ -173,7 +170,7 @@ TEST(RinexNav, Rinex2GlonassFile) {
   const RinexNavData nav = parse(text);
   ASSERT_EQ(nav.glonass.size(), 1u);
   EXPECT_EQ(nav.glonass[0].sat.to_string(), "R01");
-  EXPECT_EQ(nav.glonass[0].tb_gps_ns, cal_ns(2023, 3, 14, 0, 15, 18.0));
+  EXPECT_EQ(nav.glonass[0].tb_gps_ns, test::gps_calendar_ns(2023, 3, 14, 0, 15, 18.0));
   EXPECT_DOUBLE_EQ(nav.glonass[0].vel_mps.z(), -0.111494159698e+01 * 1e3);
 }
 

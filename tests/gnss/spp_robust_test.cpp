@@ -11,6 +11,7 @@
 #include "pdnav/gnss/measurements.h"
 #include "pdnav/gnss/solver_synthetic.h"
 #include "pdnav/gnss/spp.h"
+#include "synthetic_sky.h"
 
 namespace pdnav::gnss {
 namespace {
@@ -18,9 +19,7 @@ namespace {
 const geo::Ecef kRx = geo::to_ecef(geo::Geodetic::from_deg(37.4, -122.1, 10.0));
 
 SppOptions fde_only(SppFde method) {
-  SppOptions o;
-  o.ionosphere = false;
-  o.troposphere = false;
+  SppOptions o = test::no_atmosphere();
   o.robust_igg3 = false;  // the FDE alone
   o.fde = method;
   // weights that match the simulated noise: 1 m at zenith (noise 0.5 m), mapped by elevation
@@ -33,17 +32,10 @@ std::vector<SppObservation> observe(const std::vector<SyntheticSat>& sky, const 
                                     std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0.0, 0.5);
-  std::vector<SppObservation> obs;
-  for (std::size_t i = 0; i < sky.size(); ++i) {
-    const auto& s = sky[i];
-    SppObservation o;
-    o.sat = s.sat;
-    o.cn0_dbhz = 40.0;
-    o.carrier_hz = default_carrier_hz(s.sat.sys);
-    o.state = s.state;
-    o.pseudorange_m = sagnac_range_m(s.state.pos.p_m, kRx.p_m) + 30.0 -
-                      kSpeedOfLight_mps * (s.state.clock_bias_s - s.state.group_delay_s) + noise(rng) + fault[i];
-    obs.push_back(o);
+  std::vector<SppObservation> obs = test::observe(sky, kRx, 30.0);
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    obs[i].pseudorange_m += noise(rng);
+    obs[i].pseudorange_m += fault[i];
   }
   return obs;
 }

@@ -8,39 +8,16 @@
 #include "pdnav/gnss/solver_synthetic.h"
 #include "pdnav/gnss/measurements.h"
 #include "pdnav/gnss/spp.h"
+#include "synthetic_sky.h"
 
 namespace pdnav::gnss {
 namespace {
 
 const geo::Ecef kRx = geo::to_ecef(geo::Geodetic::from_deg(37.422578, -122.081678, -28.0));
 
-SppOptions no_atmosphere() {
-  SppOptions o;
-  o.ionosphere = false;
-  o.troposphere = false;
-  return o;
-}
-
-std::vector<SppObservation> observe(const std::vector<SyntheticSat>& sky, double clock_m,
-                                    const std::map<Constellation, double>& isb = {}) {
-  std::vector<SppObservation> obs;
-  for (const auto& s : sky) {
-    SppObservation o;
-    o.sat = s.sat;
-    o.cn0_dbhz = 40.0;
-    o.carrier_hz = default_carrier_hz(s.sat.sys);  // B1I for BeiDou (its TGD1 applies)
-    o.state = s.state;
-    const auto it = isb.find(s.sat.sys);
-    o.pseudorange_m = sagnac_range_m(s.state.pos.p_m, kRx.p_m) + clock_m + (it == isb.end() ? 0.0 : it->second) -
-                      kSpeedOfLight_mps * (s.state.clock_bias_s - s.state.group_delay_s);
-    obs.push_back(o);
-  }
-  return obs;
-}
-
 TEST(SppSynthetic, ExactObservationsGiveTheTruth) {
   const auto sky = synthetic_sky(kRx, 8, 1);
-  const SppSolution s = solve_spp(observe(sky, 1234.5), geo::Ecef(), 0.0, nullptr, no_atmosphere());
+  const SppSolution s = solve_spp(test::observe(sky, kRx, 1234.5), geo::Ecef(), 0.0, nullptr, test::no_atmosphere());
   ASSERT_TRUE(s.ok) << s.reason;
   EXPECT_LT((s.pos.p_m - kRx.p_m).norm(), 1e-3);
   EXPECT_NEAR(s.clock_m, 1234.5, 1e-3);
@@ -52,8 +29,8 @@ TEST(SppSynthetic, ExactObservationsGiveTheTruth) {
 
 TEST(SppSynthetic, EstimatesInterSystemBiases) {
   const auto sky = synthetic_sky(kRx, 12, 2, {Constellation::kGps, Constellation::kGalileo, Constellation::kBeidou});
-  const SppSolution s = solve_spp(observe(sky, -50.0, {{Constellation::kGalileo, 30.0}, {Constellation::kBeidou, -12.0}}),
-                                  geo::Ecef(), 0.0, nullptr, no_atmosphere());
+  const auto obs = test::observe(sky, kRx, -50.0, {{Constellation::kGalileo, 30.0}, {Constellation::kBeidou, -12.0}});
+  const SppSolution s = solve_spp(obs, geo::Ecef(), 0.0, nullptr, test::no_atmosphere());
   ASSERT_TRUE(s.ok) << s.reason;
   EXPECT_EQ(s.clock_system, Constellation::kGps);
   EXPECT_LT((s.pos.p_m - kRx.p_m).norm(), 1e-3);
@@ -68,9 +45,9 @@ TEST(SppSynthetic, NoisyFixWithinItsPredictedSigma) {
   const auto sky = synthetic_sky(kRx, 10, 3);
   int inside = 0;
   for (int trial = 0; trial < 200; ++trial) {
-    auto obs = observe(sky, 10.0);
+    auto obs = test::observe(sky, kRx, 10.0);
     for (auto& o : obs) o.pseudorange_m += noise(rng);
-    const SppSolution s = solve_spp(obs, geo::Ecef(), 0.0, nullptr, no_atmosphere());
+    const SppSolution s = solve_spp(obs, geo::Ecef(), 0.0, nullptr, test::no_atmosphere());
     ASSERT_TRUE(s.ok);
     const double e = (s.pos.p_m - kRx.p_m).norm();
     inside += e < 3.0 * std::sqrt(s.pos_cov_ecef.trace()) ? 1 : 0;
@@ -80,9 +57,9 @@ TEST(SppSynthetic, NoisyFixWithinItsPredictedSigma) {
 
 TEST(SppSynthetic, FaultDetectionExcludesTheFaultySatellite) {
   const auto sky = synthetic_sky(kRx, 10, 4);
-  auto obs = observe(sky, 0.0);
+  auto obs = test::observe(sky, kRx, 0.0);
   obs[3].pseudorange_m += 80.0;
-  const SppSolution s = solve_spp(obs, geo::Ecef(), 0.0, nullptr, no_atmosphere());
+  const SppSolution s = solve_spp(obs, geo::Ecef(), 0.0, nullptr, test::no_atmosphere());
   ASSERT_TRUE(s.ok) << s.reason;
   ASSERT_EQ(s.excluded_fde.size(), 1u);
   EXPECT_EQ(s.excluded_fde[0], sky[3].sat);
@@ -92,10 +69,10 @@ TEST(SppSynthetic, FaultDetectionExcludesTheFaultySatellite) {
 
 TEST(SppSynthetic, FewerThanFourSatellites) {
   const auto sky = synthetic_sky(kRx, 3, 5);
-  const SppSolution s = solve_spp(observe(sky, 0.0), geo::Ecef(), 0.0, nullptr, no_atmosphere());
+  const SppSolution s = solve_spp(test::observe(sky, kRx, 0.0), geo::Ecef(), 0.0, nullptr, test::no_atmosphere());
   EXPECT_FALSE(s.ok);
   EXPECT_EQ(s.reason, "fewer than 4 satellites");
-  EXPECT_FALSE(solve_spp({}, geo::Ecef(), 0.0, nullptr, no_atmosphere()).ok);
+  EXPECT_FALSE(solve_spp({}, geo::Ecef(), 0.0, nullptr, test::no_atmosphere()).ok);
 }
 
 TEST(SppSynthetic, SingularGeometryIsRejected) {
@@ -108,7 +85,7 @@ TEST(SppSynthetic, SingularGeometryIsRejected) {
     s.state.pos.p_m = kRx.p_m + u * (2.0e7 + 1.0e5 * i);
     sky.push_back(s);
   }
-  const SppSolution s = solve_spp(observe(sky, 0.0), kRx, 0.0, nullptr, no_atmosphere());
+  const SppSolution s = solve_spp(test::observe(sky, kRx, 0.0), kRx, 0.0, nullptr, test::no_atmosphere());
   EXPECT_FALSE(s.ok);
   EXPECT_NE(s.reason.find("singular"), std::string::npos) << s.reason;
   EXPECT_TRUE(s.pos.p_m.allFinite());
@@ -116,10 +93,10 @@ TEST(SppSynthetic, SingularGeometryIsRejected) {
 
 TEST(SppSynthetic, NonFiniteInputsAreCountedNotUsed) {
   const auto sky = synthetic_sky(kRx, 9, 7);
-  auto obs = observe(sky, 0.0);
+  auto obs = test::observe(sky, kRx, 0.0);
   obs[0].pseudorange_m = kNaN;
   obs[1].state.pos.p_m.x() = std::numeric_limits<double>::infinity();
-  const SppSolution s = solve_spp(obs, geo::Ecef(), 0.0, nullptr, no_atmosphere());
+  const SppSolution s = solve_spp(obs, geo::Ecef(), 0.0, nullptr, test::no_atmosphere());
   ASSERT_TRUE(s.ok);
   EXPECT_EQ(s.excluded.at("spp: non-finite input"), 2);
   EXPECT_EQ(s.used.size(), 7u);
@@ -128,7 +105,7 @@ TEST(SppSynthetic, NonFiniteInputsAreCountedNotUsed) {
 TEST(SppSynthetic, AtmosphereModelIsRemoved) {
   // observations generated with the same Saastamoinen model: the solver must remove it
   const auto sky = synthetic_sky(kRx, 9, 8);
-  auto obs = observe(sky, 0.0);
+  auto obs = test::observe(sky, kRx, 0.0);
   const geo::Geodetic g = geo::to_geodetic(kRx);
   for (auto& o : obs) {
     const Eigen::Vector3d sat = rotate_for_travel_time(o.state.pos.p_m, (o.state.pos.p_m - kRx.p_m).norm() / kSpeedOfLight_mps);

@@ -29,6 +29,15 @@ struct Case {
 };
 const Case kCases[] = {{1.5, 20, 1}, {1.5, 28, 2}, {1.8, 20, 1}, {1.8, 28, 2}, {2.0, 20, 2}, {2.0, 28, 1}};
 
+/// The simulated swinging-hand walk of a case.
+auto walk_of(const Case& c) {
+  test::SwingSpec spec;
+  spec.cadence_hz = c.cadence_hz;
+  spec.swing_amplitude_deg = c.swing_deg;
+  spec.seed = c.seed;
+  return test::make_swinging_walk(spec);
+}
+
 /// Accelerometer lines of an ILC walk (tab-separated "unix_ms TYPE_ACCELEROMETER x y z acc").
 std::vector<AccelSample> read_ilc_accel(const std::string& path) {
   std::ifstream in(path);
@@ -71,11 +80,7 @@ TEST(SwingingHand, SimulationHasTheStrideSignature) {
   StepDetectorOptions off;
   off.stride_harmonic_ratio = 0.0;
   for (const Case& c : kCases) {
-    test::SwingSpec spec;
-    spec.cadence_hz = c.cadence_hz;
-    spec.swing_amplitude_deg = c.swing_deg;
-    spec.seed = c.seed;
-    const auto walk = test::make_swinging_walk(spec);
+    const auto walk = walk_of(c);
     const double truth = static_cast<double>(walk.heel_strikes_ns.size());
     EXPECT_LT(static_cast<double>(detect_steps(walk.accel, off).size()), 0.7 * truth)
         << c.cadence_hz << " Hz, " << c.swing_deg << " deg";
@@ -85,11 +90,7 @@ TEST(SwingingHand, SimulationHasTheStrideSignature) {
 TEST(SwingingHand, EveryStepIsCounted) {
   double sum_ratio = 0.0;
   for (const Case& c : kCases) {
-    test::SwingSpec spec;
-    spec.cadence_hz = c.cadence_hz;
-    spec.swing_amplitude_deg = c.swing_deg;
-    spec.seed = c.seed;
-    const auto walk = test::make_swinging_walk(spec);
+    const auto walk = walk_of(c);
     const double truth = static_cast<double>(walk.heel_strikes_ns.size());
     const double found = static_cast<double>(detect_steps(walk.accel, StepDetectorOptions{}).size());
     std::printf("swinging hand %.1f Hz, %2.0f deg, seed %llu: %3.0f of %3.0f steps\n", c.cadence_hz, c.swing_deg,

@@ -9,6 +9,7 @@
 #include "pdnav/geo/time.h"
 #include "pdnav/gnss/rinex.h"
 #include "pdnav/gnss/sp3.h"
+#include "line_reader.h"
 
 namespace pdnav::gnss {
 namespace {
@@ -24,7 +25,7 @@ std::vector<std::string> tokens(const std::string& l) {
 
 class ClockParser {
  public:
-  ClockParser(std::istream& in, std::string name) : in_(in), name_(std::move(name)) {}
+  ClockParser(std::istream& in, std::string name) : lines_(in, std::move(name)) {}
 
   ClockFile run() {
     header();
@@ -44,16 +45,8 @@ class ClockParser {
   }
 
  private:
-  bool next(std::string& l) {
-    if (!std::getline(in_, l)) return false;
-    if (!l.empty() && l.back() == '\r') l.pop_back();
-    ++line_no_;
-    return true;
-  }
-
-  [[noreturn]] void fail(const std::string& reason) const {
-    throw std::runtime_error(name_ + ":" + std::to_string(line_no_) + ": " + reason);
-  }
+  bool next(std::string& l) { return lines_.next(l); }
+  [[noreturn]] void fail(const std::string& reason) const { lines_.fail(reason); }
 
   void header() {
     std::string l;
@@ -148,9 +141,7 @@ class ClockParser {
     for (int i = 0; i < n && next(l); ++i) {}
   }
 
-  std::istream& in_;
-  std::string name_;
-  int line_no_ = 0;
+  detail::LineReader lines_;
   ClockFile out_;
 };
 

@@ -6,13 +6,16 @@
 
 #include "pdnav/geo/time.h"
 #include "pdnav/gnss/rinex.h"
+#include "line_reader.h"
 
 namespace pdnav::gnss {
 namespace {
 
 class Sp3Parser {
  public:
-  Sp3Parser(std::istream& in, std::string name) : in_(in), name_(std::move(name)) {}
+  // Empty lines read as one blank: the record dispatch looks at l[0] of every line.
+  Sp3Parser(std::istream& in, std::string name)
+      : lines_(in, std::move(name), detail::LineReader::EmptyLine::kAsBlank) {}
 
   Sp3File run() {
     std::string l;
@@ -37,17 +40,8 @@ class Sp3Parser {
   }
 
  private:
-  bool next(std::string& l) {
-    if (!std::getline(in_, l)) return false;
-    if (!l.empty() && l.back() == '\r') l.pop_back();
-    ++line_no_;
-    if (l.empty()) l = " ";
-    return true;
-  }
-
-  [[noreturn]] void fail(const std::string& reason) const {
-    throw std::runtime_error(name_ + ":" + std::to_string(line_no_) + ": " + reason);
-  }
+  bool next(std::string& l) { return lines_.next(l); }
+  [[noreturn]] void fail(const std::string& reason) const { lines_.fail(reason); }
 
   void offset_check() const {
     const std::string& ts = out_.time_system;
@@ -109,9 +103,7 @@ class Sp3Parser {
     out_.epochs.back().sats[sat] = s;
   }
 
-  std::istream& in_;
-  std::string name_;
-  int line_no_ = 0;
+  detail::LineReader lines_;
   bool time_system_seen_ = false;
   Sp3File out_;
 };

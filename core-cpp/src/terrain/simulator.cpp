@@ -150,46 +150,159 @@ std::uint64_t walk_seed(std::uint64_t base_seed, std::uint64_t k) {
 
 namespace {
 
-SimulatedWalk simulate_walk_filter_models(const Dem& dem, const WalkSimOptions& o, std::uint64_t seed) {
+/// What a step of the walk is: its period and true length.
+struct StepMotion { double dt_s, len_m; };
+
+/// The earlier filter-like error models (docs/terrain.md): FOGM heading and baro bias, magnetic
+/// disturbance and gust bumps, a smooth DEM error field, a per-walk step length and scale error.
+/// Members are drawn from the walk's generator in declaration order (the walk's seed fixes them).
+class FilterModels {
+ public:
+  FilterModels(const Dem& dem, const WalkSimOptions& o, double target_m, const std::vector<RoutePoint>& /*route*/,
+               Rng& rng)
+      : dem_(dem),
+        o_(o),
+        dem_error_(dem, o.dem_error_sigma_m, o.dem_error_corr_m, rng),
+        expected_s_(target_m / o.step_length_mean_m / o.step_rate_hz * 1.3 + 60.0),
+        disturbance_(o.disturbance_rate_per_s, o.disturbance_max_rad, o.disturbance_min_s, o.disturbance_max_s,
+                     expected_s_, rng),
+        gusts_(o.gust_rate_per_s, o.gust_max_pa, o.gust_min_s, o.gust_max_s, expected_s_, rng),
+        heading_bias_(o.heading_bias_sigma_rad, o.heading_bias_tau_s, rng),
+        baro_bias_(o.baro_bias_sigma_m, o.baro_bias_tau_s, rng),
+        drift_pa_per_s_(gauss(rng, o.weather_drift_sd_pa_per_h) / 3600.0),
+        walk_step_m_(std::max(0.4, o.step_length_mean_m + gauss(rng, o.step_length_walk_sd_m))),
+        scale_error_(gauss(rng, o.length_scale_error_sd)) {
+    // The day's atmosphere: ISA lapse rate, warmer or colder.
+    atmosphere_.ref_temperature_k += gauss(rng, o.temperature_offset_sd_k);
+  }
+  /// After the declared start is drawn: the baro bias's first sample.
+  void start(Rng& rng) { bias_m_ = baro_bias_.advance(0.0, rng); }
+  /// Each loop pass draws the step period first, even on a pass that only moves to the next leg.
+  void begin_pass(Rng& rng) {
+    dt_s_ = std::max(0.2, (1.0 + gauss(rng, o_.step_period_jitter)) / o_.step_rate_hz);
+  }
+  StepMotion motion(double /*e*/, double /*n*/, double /*heading*/, double /*t_s*/, double dist, Rng& rng) {
+    return {dt_s_, std::min(dist, std::max(0.3, walk_step_m_ + gauss(rng, o_.step_length_jitter_m)))};
+  }
+  double true_height(double e, double n) const { return dem_.at_local(e, n).elevation_m + dem_error_.at(e, n); }
+  double pressure_pa(double t_s, double baro_dt_s, double e, double n, Rng& rng) {
+    bias_m_ = baro_bias_.advance(baro_dt_s, rng);
+    const double h = true_height(e, n) + bias_m_;
+    return geo::baro_pressure_pa(h, o_.sea_level_pressure_pa + drift_pa_per_s_ * t_s, 0.0, atmosphere_) +
+           gusts_.at(t_s) + gauss(rng, o_.baro_noise_pa);
+  }
+  /// The PDR's step: biased, disturbed and noisy heading; scaled, noisy length.
+  void measure(PdrStep& step, double t_s, double dt_s, double heading, double len, double /*e*/, double /*n*/,
+               Rng& rng) {
+    const double hb = heading_bias_.advance(dt_s, rng);
+    step.length_m = std::max(0.0, len * (1.0 + scale_error_) + gauss(rng, o_.length_noise_m));
+    step.heading_rad = wrap_two_pi(heading + hb + disturbance_.at(t_s) + gauss(rng, o_.heading_noise_rad));
+  }
+
+ private:
+  const Dem& dem_;
+  const WalkSimOptions& o_;
+  const ErrorField dem_error_;
+  const double expected_s_;
+  const BumpProcess disturbance_;
+  const BumpProcess gusts_;
+  Fogm heading_bias_;
+  Fogm baro_bias_;
+  const double drift_pa_per_s_;
+  const double walk_step_m_;
+  const double scale_error_;
+  geo::BaroOptions atmosphere_;
+  double bias_m_ = 0.0;
+  double dt_s_ = 0.0;
+};
+
+/// The world error models (docs/simulator.md): nothing here is the filter's own model.
+/// Members are drawn from the walk's generator in declaration order (the walk's seed fixes them).
+class WorldModels {
+ public:
+  WorldModels(const Dem& dem, const WalkSimOptions& o, double target_m, const std::vector<RoutePoint>& route, Rng& rng)
+      : dem_(dem),
+        o_(o),
+        dem_error_(
+            o.dem_world, dem.min_e_m(), dem.min_n_m(), dem.max_e_m(), dem.max_n_m(),
+            [&dem](double e, double n) {
+              const double d = 30.0;
+              const double gx = (dem.at_local(e + d, n).elevation_m - dem.at_local(e - d, n).elevation_m) / (2 * d);
+              const double gy = (dem.at_local(e, n + d).elevation_m - dem.at_local(e, n - d).elevation_m) / (2 * d);
+              return std::isfinite(gx) && std::isfinite(gy) ? std::atan(std::hypot(gx, gy)) * kRadToDeg : 0.0;
+            },
+            [&dem](double e, double n) { return dem.at_local(e, n).elevation_m; }, rng),
+        baro_(o.baro_world, target_m / o.step_length_mean_m / o.step_rate_hz * 1.5 + 120.0, rng),
+        heading_err_(o.heading_world, sim::anomalies_along(route_points(route), o.anomalies_per_km, o.heading_world, rng),
+                     rng),
+        stride_(stride_options(o), o.step_length_mean_m, rng) {}
+  void start(Rng& /*rng*/) {}
+  void begin_pass(Rng& /*rng*/) {}
+  /// The true stride follows the grade 2 m ahead.
+  StepMotion motion(double e, double n, double heading, double t_s, double dist, Rng& rng) const {
+    const double x_ahead = e + 2.0 * std::sin(heading), y_ahead = n + 2.0 * std::cos(heading);
+    double grade = (true_height(x_ahead, y_ahead) - true_height(e, n)) / 2.0;
+    if (!std::isfinite(grade)) grade = 0.0;
+    const double dt = stride_.period_s(grade, rng);
+    return {dt, std::min(dist, stride_.length_m(t_s, grade, rng))};
+  }
+  /// DEM = true ground + error.
+  double true_height(double e, double n) const { return dem_.at_local(e, n).elevation_m - dem_error_.error_m(e, n); }
+  double pressure_pa(double t_s, double /*baro_dt_s*/, double e, double n, Rng& rng) const {
+    return baro_.pressure_pa(t_s, true_height(e, n) + o_.phone_height_m, rng);
+  }
+  /// The PDR's model step: it does not know the walker.
+  void measure(PdrStep& step, double t_s, double /*dt_s*/, double heading, double /*len*/, double e, double n,
+               Rng& rng) {
+    step.length_m = o_.step_length_mean_m;
+    step.heading_rad = wrap_two_pi(heading + heading_err_.advance(t_s, Eigen::Vector2d(e, n), rng));
+  }
+
+ private:
+  static std::vector<Eigen::Vector2d> route_points(const std::vector<RoutePoint>& route) {
+    std::vector<Eigen::Vector2d> pts;
+    for (const RoutePoint& p : route) pts.emplace_back(p.e, p.n);
+    return pts;
+  }
+  static sim::StrideOptions stride_options(const WalkSimOptions& o) {
+    sim::StrideOptions so = o.stride_world;
+    so.cadence_min_hz = so.cadence_max_hz = o.step_rate_hz;  // the walk's cadence option still applies
+    so.cadence_cv = o.step_period_jitter;
+    return so;
+  }
+
+  const Dem& dem_;
+  const WalkSimOptions& o_;
+  const sim::DemError dem_error_;
+  const sim::BaroWorld baro_;
+  sim::HeadingError heading_err_;
+  const sim::Stride stride_;
+};
+
+/// One walk: a route, the error models drawn for it, the declared start, then the route walked
+/// step by step with pressure samples at baro_rate_hz between steps.
+template <class Models>
+SimulatedWalk simulate_walk_with(const Dem& dem, const WalkSimOptions& o, std::uint64_t seed) {
   Rng rng(seed);
   SimulatedWalk w;
   w.seed = seed;
   w.t0_ns = kNsPerS;
   const double target = uniform(rng, o.min_length_m, o.max_length_m);
   const std::vector<RoutePoint> route = make_route(dem, o, target, rng);
-  const ErrorField dem_error(dem, o.dem_error_sigma_m, o.dem_error_corr_m, rng);
-  const double expected_s = target / o.step_length_mean_m / o.step_rate_hz * 1.3 + 60.0;
-  const BumpProcess disturbance(o.disturbance_rate_per_s, o.disturbance_max_rad, o.disturbance_min_s,
-                                o.disturbance_max_s, expected_s, rng);
-  const BumpProcess gusts(o.gust_rate_per_s, o.gust_max_pa, o.gust_min_s, o.gust_max_s, expected_s, rng);
-  Fogm heading_bias(o.heading_bias_sigma_rad, o.heading_bias_tau_s, rng);
-  Fogm baro_bias(o.baro_bias_sigma_m, o.baro_bias_tau_s, rng);
-  const double drift_pa_per_s = gauss(rng, o.weather_drift_sd_pa_per_h) / 3600.0;
-  const double walk_step_m = std::max(0.4, o.step_length_mean_m + gauss(rng, o.step_length_walk_sd_m));
-  const double scale_error = gauss(rng, o.length_scale_error_sd);
-  geo::BaroOptions atmosphere;  // the day's atmosphere: ISA lapse rate, warmer or colder
-  atmosphere.ref_temperature_k += gauss(rng, o.temperature_offset_sd_k);
+  Models models(dem, o, target, route, rng);
 
   // Declared start.
   const Eigen::Vector2d start(route[0].e, route[0].n);
   w.declared_start_en = start + Eigen::Vector2d(gauss(rng, o.start_sigma_m), gauss(rng, o.start_sigma_m));
   w.declared_start = dem.to_geodetic(w.declared_start_en.x(), w.declared_start_en.y());
   w.declared_sigma_m = o.start_sigma_m;
+  models.start(rng);
 
-  auto true_height = [&](double e, double n) { return dem.at_local(e, n).elevation_m + dem_error.at(e, n); };
-  auto pressure_at = [&](double t_s, double e, double n, double bias_m, Rng& r) {
-    const double h = true_height(e, n) + bias_m;
-    return geo::baro_pressure_pa(h, o.sea_level_pressure_pa + drift_pa_per_s * t_s, 0.0, atmosphere) + gusts.at(t_s) +
-           gauss(r, o.baro_noise_pa);
-  };
-
-  // Walk the route step by step; pressure samples at baro_rate_hz between steps.
   double e = start.x(), n = start.y(), heading = route[0].heading, t_s = 0.0, t_baro = 0.0;
-  double bias_m = baro_bias.advance(0.0, rng);
   const double baro_dt = 1.0 / o.baro_rate_hz;
   std::size_t leg = 1;
   while (leg < route.size()) {
-    const double dt = std::max(0.2, (1.0 + gauss(rng, o.step_period_jitter)) / o.step_rate_hz);
+    models.begin_pass(rng);
     // Aim at the next route point; turn at most 30 degrees per step (smooth corners).
     const double de = route[leg].e - e, dn = route[leg].n - n;
     const double dist = std::hypot(de, dn);
@@ -199,7 +312,8 @@ SimulatedWalk simulate_walk_filter_models(const Dem& dem, const WalkSimOptions& 
     }
     const double turn = std::clamp(wrap_pi(std::atan2(de, dn) - heading), -30 * kDegToRad, 30 * kDegToRad);
     heading = wrap_two_pi(heading + turn);
-    const double len = std::min(dist, std::max(0.3, walk_step_m + gauss(rng, o.step_length_jitter_m)));
+    const StepMotion m = models.motion(e, n, heading, t_s, dist, rng);
+    const double dt = m.dt_s, len = m.len_m;
     const double e_prev = e, n_prev = n;
     e += len * std::sin(heading);
     n += len * std::cos(heading);
@@ -208,18 +322,15 @@ SimulatedWalk simulate_walk_filter_models(const Dem& dem, const WalkSimOptions& 
     // Pressure samples in (t_prev, t_s], position interpolated along the step.
     while (t_baro + baro_dt <= t_s) {
       t_baro += baro_dt;
-      bias_m = baro_bias.advance(baro_dt, rng);
       const double f = (t_baro - t_prev) / dt;
       PressureSample ps;
       ps.t_ns = w.t0_ns + s_to_ns(t_baro);
-      ps.pressure_pa = pressure_at(t_baro, e_prev + f * (e - e_prev), n_prev + f * (n - n_prev), bias_m, rng);
+      ps.pressure_pa = models.pressure_pa(t_baro, baro_dt, e_prev + f * (e - e_prev), n_prev + f * (n - n_prev), rng);
       w.pressure.push_back(ps);
     }
-    const double hb = heading_bias.advance(dt, rng);
     PdrStep step;
     step.t_ns = w.t0_ns + s_to_ns(t_s);
-    step.length_m = std::max(0.0, len * (1.0 + scale_error) + gauss(rng, o.length_noise_m));
-    step.heading_rad = wrap_two_pi(heading + hb + disturbance.at(t_s) + gauss(rng, o.heading_noise_rad));
+    models.measure(step, t_s, dt, heading, len, e, n, rng);
     step.heading_sigma_rad = o.heading_bias_sigma_rad;
     step.length_sigma_m = o.length_noise_m;
     w.steps.push_back(step);
@@ -228,92 +339,7 @@ SimulatedWalk simulate_walk_filter_models(const Dem& dem, const WalkSimOptions& 
     truth.t_ns = step.t_ns;
     truth.lat_deg = g.lat_deg();
     truth.lon_deg = g.lon_deg();
-    truth.h_m = true_height(e, n);
-    truth.heading_deg = rad_to_deg(heading);
-    w.truth.push_back(truth);
-    w.truth_en.emplace_back(e, n);
-    w.length_m += len;
-  }
-  return w;
-}
-
-/// The world error models (docs/simulator.md): nothing here is the filter's own model.
-SimulatedWalk simulate_walk_world(const Dem& dem, const WalkSimOptions& o, std::uint64_t seed) {
-  Rng rng(seed);
-  SimulatedWalk w;
-  w.seed = seed;
-  w.t0_ns = kNsPerS;
-  const double target = uniform(rng, o.min_length_m, o.max_length_m);
-  const std::vector<RoutePoint> route = make_route(dem, o, target, rng);
-  auto slope_deg = [&dem](double e, double n) {
-    const double d = 30.0;
-    const double gx = (dem.at_local(e + d, n).elevation_m - dem.at_local(e - d, n).elevation_m) / (2 * d);
-    const double gy = (dem.at_local(e, n + d).elevation_m - dem.at_local(e, n - d).elevation_m) / (2 * d);
-    return std::isfinite(gx) && std::isfinite(gy) ? std::atan(std::hypot(gx, gy)) * kRadToDeg : 0.0;
-  };
-  const sim::DemError dem_error(o.dem_world, dem.min_e_m(), dem.min_n_m(), dem.max_e_m(), dem.max_n_m(), slope_deg,
-                                [&dem](double e, double n) { return dem.at_local(e, n).elevation_m; }, rng);
-  const double expected_s = target / o.step_length_mean_m / o.step_rate_hz * 1.5 + 120.0;
-  const sim::BaroWorld baro(o.baro_world, expected_s, rng);
-  std::vector<Eigen::Vector2d> pts;
-  for (const RoutePoint& p : route) pts.emplace_back(p.e, p.n);
-  sim::HeadingError heading_err(o.heading_world, sim::anomalies_along(pts, o.anomalies_per_km, o.heading_world, rng), rng);
-  sim::StrideOptions so = o.stride_world;
-  so.cadence_min_hz = so.cadence_max_hz = o.step_rate_hz;  // the walk's cadence option still applies
-  so.cadence_cv = o.step_period_jitter;
-  const sim::Stride stride(so, o.step_length_mean_m, rng);
-
-  const Eigen::Vector2d start(route[0].e, route[0].n);
-  w.declared_start_en = start + Eigen::Vector2d(gauss(rng, o.start_sigma_m), gauss(rng, o.start_sigma_m));
-  w.declared_start = dem.to_geodetic(w.declared_start_en.x(), w.declared_start_en.y());
-  w.declared_sigma_m = o.start_sigma_m;
-  // DEM = true ground + error.
-  auto true_height = [&](double e, double n) { return dem.at_local(e, n).elevation_m - dem_error.error_m(e, n); };
-
-  double e = start.x(), n = start.y(), heading = route[0].heading, t_s = 0.0, t_baro = 0.0;
-  const double baro_dt = 1.0 / o.baro_rate_hz;
-  std::size_t leg = 1;
-  while (leg < route.size()) {
-    const double de = route[leg].e - e, dn = route[leg].n - n;
-    const double dist = std::hypot(de, dn);
-    if (dist < 1.0) {
-      ++leg;
-      continue;
-    }
-    const double turn = std::clamp(wrap_pi(std::atan2(de, dn) - heading), -30 * kDegToRad, 30 * kDegToRad);
-    heading = wrap_two_pi(heading + turn);
-    const double x_ahead = e + 2.0 * std::sin(heading), y_ahead = n + 2.0 * std::cos(heading);
-    double grade = (true_height(x_ahead, y_ahead) - true_height(e, n)) / 2.0;
-    if (!std::isfinite(grade)) grade = 0.0;
-    const double dt = stride.period_s(grade, rng);
-    const double len = std::min(dist, stride.length_m(t_s, grade, rng));
-    const double e_prev = e, n_prev = n;
-    e += len * std::sin(heading);
-    n += len * std::cos(heading);
-    const double t_prev = t_s;
-    t_s += dt;
-    while (t_baro + baro_dt <= t_s) {
-      t_baro += baro_dt;
-      const double f = (t_baro - t_prev) / dt;
-      PressureSample ps;
-      ps.t_ns = w.t0_ns + s_to_ns(t_baro);
-      ps.pressure_pa =
-          baro.pressure_pa(t_baro, true_height(e_prev + f * (e - e_prev), n_prev + f * (n - n_prev)) + o.phone_height_m, rng);
-      w.pressure.push_back(ps);
-    }
-    PdrStep step;
-    step.t_ns = w.t0_ns + s_to_ns(t_s);
-    step.length_m = o.step_length_mean_m;  // the PDR's model step: it does not know the walker
-    step.heading_rad = wrap_two_pi(heading + heading_err.advance(t_s, Eigen::Vector2d(e, n), rng));
-    step.heading_sigma_rad = o.heading_bias_sigma_rad;
-    step.length_sigma_m = o.length_noise_m;
-    w.steps.push_back(step);
-    const geo::Geodetic g = dem.to_geodetic(e, n);
-    TruthSample truth;
-    truth.t_ns = step.t_ns;
-    truth.lat_deg = g.lat_deg();
-    truth.lon_deg = g.lon_deg();
-    truth.h_m = true_height(e, n);
+    truth.h_m = models.true_height(e, n);
     truth.heading_deg = rad_to_deg(heading);
     w.truth.push_back(truth);
     w.truth_en.emplace_back(e, n);
@@ -325,7 +351,7 @@ SimulatedWalk simulate_walk_world(const Dem& dem, const WalkSimOptions& o, std::
 }  // namespace
 
 SimulatedWalk simulate_walk(const Dem& dem, const WalkSimOptions& o, std::uint64_t seed) {
-  return o.world_errors ? simulate_walk_world(dem, o, seed) : simulate_walk_filter_models(dem, o, seed);
+  return o.world_errors ? simulate_walk_with<WorldModels>(dem, o, seed) : simulate_walk_with<FilterModels>(dem, o, seed);
 }
 
 WalkEvaluation evaluate_walk(const SimulatedWalk& walk, std::shared_ptr<const Dem> dem,
