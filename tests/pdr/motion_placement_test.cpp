@@ -16,39 +16,16 @@
 #include "pdnav/pdr/motion_classifier.h"
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/pdr/placement.h"
+#include "real_walk.h"
 #include "test_data.h"
 
 using namespace pdnav;
 using namespace pdnav::pdr;
+using pdnav::test::RealWalk;
+using pdnav::test::read_ilc;
+using pdnav::test::run;
 
 namespace {
-
-struct RealWalk {
-  std::vector<AccelSample> accel;
-  std::vector<GyroSample> gyro;
-  std::vector<RotationVectorSample> rotation;
-};
-
-/// The sensor lines of one ILC walk (tab-separated "unix_ms TYPE x y z [acc]").
-RealWalk read_ilc(const std::string& path) {
-  RealWalk w;
-  std::ifstream in(path);
-  EXPECT_TRUE(in.good()) << path;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream ss(line);
-    std::int64_t ms = 0;
-    std::string type;
-    double x = 0, y = 0, z = 0;
-    if (!(ss >> ms >> type >> x >> y >> z)) continue;
-    const TimeNs t = ms * 1'000'000;
-    if (type == "TYPE_ACCELEROMETER") w.accel.push_back({t, ms, {x, y, z}});
-    else if (type == "TYPE_GYROSCOPE") w.gyro.push_back({t, ms, {x, y, z}});
-    else if (type == "TYPE_ROTATION_VECTOR")
-      w.rotation.push_back({t, ms, {x, y, z, std::sqrt(std::max(0.0, 1 - x * x - y * y - z * z))}, kNaN});
-  }
-  return w;
-}
 
 const char* kWalk = "pdr-ilc2020/data/site2/F3/path_data_files/5dd38fff44333f00067aa387.txt";
 
@@ -100,23 +77,6 @@ RealWalk make_waving(const RealWalk& real, TimeNs t_end_ns, double seconds, std:
     w.gyro.push_back({t_ns, kMissingInt, rate});
   }
   return w;
-}
-
-std::vector<PdrStep> run(const PdrOptions& o, const RealWalk& a, const RealWalk* b = nullptr) {
-  Pdr p(o);
-  std::vector<PdrStep> out;
-  auto feed = [&](const RealWalk& w) {
-    std::size_t ig = 0, ir = 0;
-    for (const auto& s : w.accel) {
-      while (ig < w.gyro.size() && w.gyro[ig].t_ns <= s.t_ns) p.feed(w.gyro[ig++]);
-      while (ir < w.rotation.size() && w.rotation[ir].t_ns <= s.t_ns) p.feed(w.rotation[ir++]);
-      p.feed(s);
-      for (const auto& st : p.take_steps()) out.push_back(st);
-    }
-  };
-  feed(a);
-  if (b) feed(*b);
-  return out;
 }
 
 }  // namespace

@@ -57,10 +57,12 @@ void Pdr::feed(const AccelSample& s) {
   tracker_.feed(s);
   classifier_.feed(s);
   const bool handling = opt_.gate_handling && classifier_.state() == MotionState::kHandling;
-  if (handling) placement_.end_bout();  // the phone is being moved: re-estimate afterwards
+  const bool riding = opt_.gate_vehicle && classifier_.in_vehicle();
+  if (handling || riding) placement_.end_bout();  // the phone is being moved: re-estimate afterwards
   else placement_.feed(s, gate_.in_bout() || gate_.pending() > 0);  // first steps teach it too
   sync_placement();
   flush_undecided(s.t_ns, false);
+  settle_vehicle_wait(s.t_ns, false);
   // two steps between pauses count as a walk only while the handling gate can refuse jolts
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(s.t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
   gate_.set_short_walk_min_steps(opt_.gate_handling && gyro_live ? opt_.detector.short_walk_min_steps_gyro
@@ -116,6 +118,39 @@ Pdr::HeldStep Pdr::reprojected(HeldStep h) const {
 }
 
 void Pdr::deliver(HeldStep h, TimeNs now_ns) {
+  if (vehicle_gated()) {
+    vehicle_wait_.push_back(h);
+    return;
+  }
+  deliver_walking(h, now_ns);
+}
+
+void Pdr::settle_vehicle_wait(TimeNs now_ns, bool force) {
+  if (vehicle_wait_.empty()) return;
+  if (classifier_.in_vehicle()) {
+    // a step older than the exit look-back will be inside the span whenever it ends
+    const TimeNs keep_ns = now_ns - s_to_ns(opt_.motion.vehicle_exit_lookback_s);
+    while (!vehicle_wait_.empty() && (force || vehicle_wait_.front().candidate.t_ns < keep_ns)) {
+      ++counters_.steps_discarded_by_vehicle;
+      vehicle_wait_.pop_front();
+    }
+    return;
+  }
+  if (classifier_.vehicle_suspect() && !force) return;
+  std::deque<HeldStep> waiting;
+  waiting.swap(vehicle_wait_);
+  for (auto& h : waiting) {
+    if (classifier_.vehicle_at(h.candidate.t_ns)) {
+      ++counters_.steps_discarded_by_vehicle;
+    } else if (h.android) {
+      emit_step(h);
+    } else {
+      deliver_walking(h, now_ns);
+    }
+  }
+}
+
+void Pdr::deliver_walking(HeldStep h, TimeNs now_ns) {
   const bool wait = opt_.heading.mount == Mount::kAuto && opt_.placement.max_direction_wait_s > 0.0 &&
                     h.placement_revision == placement_.revision() && !placement_.direction_known();
   if (wait) {
@@ -148,6 +183,7 @@ void Pdr::release(const std::vector<HeldStep>& steps, TimeNs now_ns) {
 
 void Pdr::finish() {
   release(gate_.finish(), latest_ns_);
+  settle_vehicle_wait(latest_ns_, true);
   flush_undecided(latest_ns_, true);
 }
 
@@ -215,6 +251,10 @@ void Pdr::feed(const StepDetectorSample& s) {
     ++counters_.steps_discarded_by_motion;  // the phone's own detector counts waving too
     return;
   }
+  if (opt_.gate_vehicle && classifier_.in_vehicle()) {
+    ++counters_.steps_discarded_by_vehicle;  // a phone's step detector fires on bumps too
+    return;
+  }
   if (opt_.source == StepSource::kAndroid || opt_.source == StepSource::kAuto) {
     // the swing of the accelerometer's own latest step (within 2 s), else the model's fallback
     const bool fresh = last_swing_ns_ >= 0 && std::abs(ns_to_s(s.t_ns - last_swing_ns_)) <= 2.0;
@@ -222,7 +262,10 @@ void Pdr::feed(const StepDetectorSample& s) {
     event.t_ns = s.t_ns;
     event.swing_mps2 = fresh ? last_swing_mps2_ : kNaN;
     event.interval_s = 0.0;  // unknown: the length model's cadence fallback
-    emit_step(hold(event));
+    HeldStep h = hold(event);
+    h.android = true;
+    if (vehicle_gated()) vehicle_wait_.push_back(h);
+    else emit_step(h);
   }
   trim_consistency(s.t_ns);
 }
