@@ -327,3 +327,40 @@ TEST(PdrHeading, UnreliableMagnetometerAccuracyKeepsADisturbedRotationVectorFrom
   EXPECT_DOUBLE_EQ(h.accuracy_weight(3), 1.0);
   EXPECT_DOUBLE_EQ(h.accuracy_weight(-1), h.accuracy_weight(0));
 }
+
+TEST(PdrHeadingFusion, QuasiStaticFieldIsFoundOnlyWhileTheFieldIsStillInTheGyroFrame) {
+  HeadingFusionOptions o;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  auto run_for = [&](QuasiStaticField& q, TimeNs& t, double seconds, double offset_rate_radps, double field_rate_utps,
+                     int& static_count) {
+    double offset = 1.0, field = 45.0;
+    static_count = 0;
+    const int n = static_cast<int>(seconds * 50);
+    for (int i = 0; i < n; ++i) {
+      t += 20'000'000;
+      offset += offset_rate_radps * 0.02;
+      field += field_rate_utps * 0.02;
+      q.add(t, offset + 0.5 * kDegToRad * n01(rng), field + 0.2 * n01(rng));
+      static_count += i >= 50 && q.quasi_static();  // after one window of the new behaviour
+    }
+  };
+  QuasiStaticField q(o);
+  TimeNs t = 0;
+  int n_static = 0;
+  for (int i = 0; i < 30; ++i) {
+    q.add(t += 20'000'000, 1.0, 45.0);
+    EXPECT_FALSE(q.quasi_static());  // less than 80 % of a window: not yet decided
+  }
+  run_for(q, t, 3.0, 0.0, 0.0, n_static);
+  EXPECT_EQ(n_static, 100);  // a still field: quasi-static (the 100 readings after the first window)
+  EXPECT_TRUE(q.quasi_static());
+  // walking past a steel pillar: the compass turns against the gyro by 20 deg/s
+  run_for(q, t, 3.0, 20.0 * kDegToRad, 0.0, n_static);
+  EXPECT_EQ(n_static, 0);
+  // the heading agrees but |B| changes by 8 uT/s (a field gradient)
+  run_for(q, t, 3.0, 0.0, 8.0, n_static);
+  EXPECT_EQ(n_static, 0);
+  // the default Pdr uses it: readings outside a quasi-static field are down-weighted
+  EXPECT_LT(HeadingFusionOptions{}.non_qsf_weight, 1.0);
+}

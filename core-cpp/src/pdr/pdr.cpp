@@ -17,7 +17,8 @@ Pdr::Pdr(const PdrOptions& options)
       tracker_(options.heading.turn),
       classifier_(options.motion),
       placement_(options.placement),
-      fusion_(options.fusion) {}
+      fusion_(options.fusion),
+      qsf_(options.fusion) {}
 
 void Pdr::set_location(const geo::Geodetic& where, std::int64_t utc_ms) {
   const geo::Declination d = geo::declination_at(where, utc_ms);
@@ -43,6 +44,7 @@ void Pdr::sync_placement() {
   placement_revision_ = placement_.revision();
   // a new placement bout: the reference axis may have changed, restart the offset (auto only)
   if (opt_.heading.mount == Mount::kAuto) fusion_.reset();
+  qsf_.reset();  // the offset refers to the reference axis
 }
 
 void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight) {
@@ -203,11 +205,20 @@ void Pdr::feed(const MagSample& s) {
   last_field_ut_ = s.field_ut;
   latest_ns_ = std::max(latest_ns_, s.t_ns);
   if (!tracker_.has_gravity()) return;
-  if (have_rv_ && ns_to_s(s.t_ns - last_rv_ns_) <= opt_.heading.rv_max_age_s) return;  // RV wins
   const auto compass =
       compass_heading_rad(s.field_ut, tracker_.up_phone(), reference_axis(), opt_.heading.min_horizontal);
+  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(s.t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
+  if (compass && gyro_live) {
+    qsf_.add(s.t_ns, *compass + tracker_.yaw_rad(), s.field_ut.norm());
+    ++counters_.mag_readings_qsf_tested;
+    counters_.mag_readings_quasi_static += qsf_.quasi_static();
+  } else {
+    qsf_.reset();
+  }  // no gyro frame to test the field's stationarity in
+  if (have_rv_ && ns_to_s(s.t_ns - last_rv_ns_) <= opt_.heading.rv_max_age_s) return;  // RV wins
   if (!compass) return;
-  absolute_heading(s.t_ns, *compass, mag_accuracy_weight_ * fusion_.field_weight(s.field_ut, tracker_.up_phone()));
+  absolute_heading(s.t_ns, *compass,
+                   qsf_weight() * mag_accuracy_weight_ * fusion_.field_weight(s.field_ut, tracker_.up_phone()));
 }
 
 void Pdr::feed(const SensorAccuracySample& s) {
@@ -231,6 +242,7 @@ void Pdr::feed(const RotationVectorSample& s) {
   const bool mag_fresh = have_mag_last_ && ns_to_s(s.t_ns - mag_last_ns_) <= opt_.heading.rv_max_age_s;
   double w = mag_fresh && tracker_.has_gravity() ? fusion_.field_weight(last_field_ut_, tracker_.up_phone()) : 1.0;
   w *= mag_accuracy_weight_;
+  if (mag_fresh) w *= qsf_weight();  // the RV used this field: trusted only while it is quasi-static
   // the sensor's own heading accuracy (when it reports one): inverse-variance relative to one
   // nominal reading, never above it
   if (std::isfinite(s.heading_accuracy_rad) && s.heading_accuracy_rad > 0.0)

@@ -57,6 +57,8 @@ struct PdrCounters {
   std::int64_t steps_discarded_by_vehicle = 0;  // steps inside a vehicle span (car, bus, train)
   std::int64_t mag_readings_trusted = 0;       // absolute headings that passed the WMM tests
   std::int64_t mag_readings_disturbed = 0;     // ... and that failed them (down-weighted)
+  std::int64_t mag_readings_qsf_tested = 0;    // magnetometer readings tested for a quasi-static field
+  std::int64_t mag_readings_quasi_static = 0;  // ... and found quasi-static (full weight)
   std::int64_t total_skipped() const {
     return accel.skipped() + gyro.skipped() + mag.skipped() + rotation_vector.skipped() + step_detector.skipped();
   }
@@ -173,6 +175,8 @@ class Pdr {
   std::deque<HeldStep> vehicle_wait_;
   PlacementEstimator placement_;
   HeadingFusion fusion_;
+  QuasiStaticField qsf_;
+  double qsf_weight() const { return qsf_.quasi_static() ? 1.0 : opt_.fusion.non_qsf_weight; }
   std::int64_t placement_revision_ = 0;
   Eigen::Vector3d last_field_ut_ = Eigen::Vector3d::Zero();
   double mag_accuracy_weight_ = 1.0;  // no accuracy event yet: readings keep their own weight
