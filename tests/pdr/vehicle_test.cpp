@@ -150,3 +150,32 @@ TEST(PdrVehicle, NoRealWalkLosesStepsToTheVehicleClass) {
   ride.gyro.clear();
   EXPECT_LE(count(PdrOptions{}, ride).steps, 2u);
 }
+
+TEST(PdrVehicle, AndroidStepEventsDuringARideAreRefused) {
+  // the phone's own step detector fires on bumps too: one event every 0.6 s from 15 s into the
+  // ride (once the vehicle is under way), source = Android events
+  for (std::uint64_t seed : {2u, 4u}) {
+    const RealWalk ride = make_ride(ride_spec(seed), 200'000'000'000);
+    for (bool vehicle_class : {true, false}) {
+      PdrOptions o = auto_mount(vehicle_class);
+      o.source = StepSource::kAndroid;
+      Pdr p(o);
+      std::size_t ig = 0;
+      const TimeNs t0 = ride.accel.front().t_ns;
+      TimeNs next_event = t0 + 15'000'000'000;
+      for (const auto& s : ride.accel) {
+        while (ig < ride.gyro.size() && ride.gyro[ig].t_ns <= s.t_ns) p.feed(ride.gyro[ig++]);
+        p.feed(s);
+        if (s.t_ns >= next_event) {
+          p.feed(StepDetectorSample{s.t_ns, kMissingInt});
+          next_event += 600'000'000;
+        }
+      }
+      p.finish();
+      std::printf("seed %llu, vehicle class %s: %lld Android steps kept\n", static_cast<unsigned long long>(seed),
+                  vehicle_class ? "on" : "off", static_cast<long long>(p.step_count()));
+      if (vehicle_class) EXPECT_LE(p.step_count(), 2) << "seed " << seed;
+      else EXPECT_GT(p.step_count(), 100) << "seed " << seed;
+    }
+  }
+}
