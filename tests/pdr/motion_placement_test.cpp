@@ -220,17 +220,8 @@ TEST(PdrMotion, AndroidStepEventsWhileWavingAreRefused) {
   for (bool gate : {true, false}) {
     o.gate_handling = gate;
     Pdr p(o);
-    std::size_t ig = 0, counted = 0;
-    TimeNs next_event = waving.accel.front().t_ns + 2'000'000'000;
-    for (const auto& s : waving.accel) {
-      while (ig < waving.gyro.size() && waving.gyro[ig].t_ns <= s.t_ns) p.feed(waving.gyro[ig++]);
-      p.feed(s);
-      if (s.t_ns >= next_event) {
-        p.feed(StepDetectorSample{s.t_ns, kMissingInt});
-        next_event += 625'000'000;
-      }
-      counted += p.take_steps().size();
-    }
+    const std::size_t counted =
+        test::feed_with_step_events(p, waving, waving.accel.front().t_ns + 2'000'000'000, 625'000'000, false);
     if (gate) EXPECT_LE(counted, 2u);
     else EXPECT_GT(counted, 30u);  // the events are there: only the gate removes them
   }

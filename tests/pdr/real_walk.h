@@ -63,4 +63,27 @@ inline std::vector<PdrStep> run(const pdr::PdrOptions& o, const RealWalk& a, con
   return out;
 }
 
+/// Feeds a recording's accelerometer and gyroscope in time order plus an Android step-detector
+/// event every period_ns from first_event_ns (a phone detector firing); returns the steps taken
+/// (including those released by finish() when `finish`).
+inline std::size_t feed_with_step_events(pdr::Pdr& p, const RealWalk& w, TimeNs first_event_ns, TimeNs period_ns,
+                                         bool finish) {
+  std::size_t ig = 0, counted = 0;
+  TimeNs next_event = first_event_ns;
+  for (const auto& s : w.accel) {
+    while (ig < w.gyro.size() && w.gyro[ig].t_ns <= s.t_ns) p.feed(w.gyro[ig++]);
+    p.feed(s);
+    if (s.t_ns >= next_event) {
+      p.feed(StepDetectorSample{s.t_ns, kMissingInt});
+      next_event += period_ns;
+    }
+    counted += p.take_steps().size();
+  }
+  if (finish) {
+    p.finish();
+    counted += p.take_steps().size();
+  }
+  return counted;
+}
+
 }  // namespace pdnav::test

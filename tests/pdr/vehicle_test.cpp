@@ -160,22 +160,12 @@ TEST(PdrVehicle, AndroidStepEventsDuringARideAreRefused) {
       PdrOptions o = auto_mount(vehicle_class);
       o.source = StepSource::kAndroid;
       Pdr p(o);
-      std::size_t ig = 0;
-      const TimeNs t0 = ride.accel.front().t_ns;
-      TimeNs next_event = t0 + 15'000'000'000;
-      for (const auto& s : ride.accel) {
-        while (ig < ride.gyro.size() && ride.gyro[ig].t_ns <= s.t_ns) p.feed(ride.gyro[ig++]);
-        p.feed(s);
-        if (s.t_ns >= next_event) {
-          p.feed(StepDetectorSample{s.t_ns, kMissingInt});
-          next_event += 600'000'000;
-        }
-      }
-      p.finish();
+      const std::size_t kept =
+          test::feed_with_step_events(p, ride, ride.accel.front().t_ns + 15'000'000'000, 600'000'000, true);
       std::printf("seed %llu, vehicle class %s: %lld Android steps kept\n", static_cast<unsigned long long>(seed),
-                  vehicle_class ? "on" : "off", static_cast<long long>(p.step_count()));
-      if (vehicle_class) EXPECT_LE(p.step_count(), 2) << "seed " << seed;
-      else EXPECT_GT(p.step_count(), 100) << "seed " << seed;
+                  vehicle_class ? "on" : "off", static_cast<long long>(kept));
+      if (vehicle_class) EXPECT_LE(kept, 2u) << "seed " << seed;
+      else EXPECT_GT(kept, 100u) << "seed " << seed;
     }
   }
 }
