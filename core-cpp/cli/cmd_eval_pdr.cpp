@@ -19,6 +19,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -46,6 +48,11 @@ struct EvalPdrArgs {
   double tau_s = kNaN;          // heading fusion offset memory (with --via pdr)
   double field_tolerance = kNaN;
   double disturbed_weight = kNaN;
+  double non_qsf_weight = kNaN;  // quasi-static field detector (with --via pdr)
+  double qsf_std_deg = kNaN;
+  double qsf_field_std_ut = kNaN;
+  double qsf_window_s = kNaN;
+  bool compass_only = false;  // diagnostic (--via pdr): no rotation vector, heading from the raw compass
 };
 
 /// The naive reference PDR of the issue: low-passed |a| peaks, fixed 0.70 m, RV yaw.
@@ -93,6 +100,7 @@ struct WalkResult {
   double mean_m = kNaN, naive_mean_m = kNaN, length_ratio = kNaN, naive_ratio = kNaN;
   std::int64_t steps = 0;
   double declination_deg = kNaN;
+  std::int64_t qsf_tested = 0, qsf_static = 0;  // --via pdr: magnetometer readings, quasi-static ones
 };
 
 double median(std::vector<double> v) {
@@ -135,6 +143,10 @@ pdr::PdrOptions pdr_options_for(const EvalPdrArgs& a) {
   if (std::isfinite(a.tau_s)) o.fusion.tau_s = a.tau_s;
   if (std::isfinite(a.field_tolerance)) o.fusion.field_tolerance = a.field_tolerance;
   if (std::isfinite(a.disturbed_weight)) o.fusion.disturbed_weight = a.disturbed_weight;
+  if (std::isfinite(a.non_qsf_weight)) o.fusion.non_qsf_weight = a.non_qsf_weight;
+  if (std::isfinite(a.qsf_std_deg)) o.fusion.qsf_max_offset_std_rad = a.qsf_std_deg * kDegToRad;
+  if (std::isfinite(a.qsf_field_std_ut)) o.fusion.qsf_max_field_std_ut = a.qsf_field_std_ut;
+  if (std::isfinite(a.qsf_window_s)) o.fusion.qsf_window_s = a.qsf_window_s;
   if (a.legacy) {
     // the engine before issue 16: declared chest mount, heading = the latest rotation vector,
     // no magnetic gating, no motion gate, APT height model with 1.75 m
@@ -171,6 +183,7 @@ class Runner {
       nav_ = std::make_unique<fusion::Navigator>(c, 1);
     } else {
       pdr_ = std::make_unique<pdr::Pdr>(pdr_options_for(a));
+      compass_only_ = a.compass_only;
     }
   }
   void feed(const Sample& s) {
@@ -181,9 +194,12 @@ class Runner {
     std::visit(
         [&](const auto& x) {
           using T = std::decay_t<decltype(x)>;
-          if constexpr (std::is_same_v<T, AccelSample> || std::is_same_v<T, GyroSample> || std::is_same_v<T, MagSample> ||
-                        std::is_same_v<T, RotationVectorSample> || std::is_same_v<T, StepDetectorSample>)
+          if constexpr (std::is_same_v<T, RotationVectorSample>) {
+            if (!compass_only_) pdr_->feed(x);
+          } else if constexpr (std::is_same_v<T, AccelSample> || std::is_same_v<T, GyroSample> ||
+                               std::is_same_v<T, MagSample> || std::is_same_v<T, StepDetectorSample>) {
             pdr_->feed(x);
+          }
         },
         s);
     for (const PdrStep& st : pdr_->take_steps()) {
@@ -222,11 +238,18 @@ class Runner {
   }
   double path_m() const { return path_m_; }
   std::int64_t steps() const { return nav_ ? nav_->output(0).steps : steps_; }
+  /// Magnetometer readings tested for a quasi-static field and found so (direct Pdr only).
+  std::pair<std::int64_t, std::int64_t> quasi_static_field() const {
+    if (!pdr_) return {0, 0};
+    const pdr::PdrCounters c = pdr_->counters();
+    return {c.mag_readings_qsf_tested, c.mag_readings_quasi_static};
+  }
 
  private:
   bool via_nav_;
   bool wmm_;
   std::unique_ptr<fusion::Navigator> nav_;
+  bool compass_only_ = false;
   std::unique_ptr<pdr::Pdr> pdr_;
   geo::LocalFrame frame_;
   bool started_ = false;
@@ -320,6 +343,7 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   r.length_ratio = truth_len > 0 ? run.path_m() / truth_len : kNaN;
   r.naive_ratio = truth_len > 0 ? naive_path_m / truth_len : kNaN;
   r.steps = run.steps();
+  std::tie(r.qsf_tested, r.qsf_static) = run.quasi_static_field();
   return r;
 }
 
@@ -370,6 +394,11 @@ int run_eval_pdr(const EvalPdrArgs& a) {
               median(herr), median(abs_herr), herr.size(), all.front().declination_deg);
   std::printf("naive (rotation vector +Y, magnetic, no declination): segment heading error median signed %.1f deg\n",
               median(naive_herr));
+  std::int64_t qsf_tested = 0, qsf_static = 0;
+  for (const auto& r : all) qsf_tested += r.qsf_tested, qsf_static += r.qsf_static;
+  if (qsf_tested > 0)
+    std::printf("quasi-static field: %lld of %lld magnetometer readings (%.1f %%)\n", static_cast<long long>(qsf_static),
+                static_cast<long long>(qsf_tested), 100.0 * static_cast<double>(qsf_static) / static_cast<double>(qsf_tested));
   std::printf("per-walk mean error: p25 %.2f m, p75 %.2f m, max %.2f m\n", percentile(means, 25), percentile(means, 75),
               percentile(means, 100));
   std::printf("median_mean_error_m: %.2f median_length_ratio: %.3f\n", median(means), median(ratios));
@@ -395,6 +424,11 @@ void register_eval_pdr(CLI::App& app) {
   c->add_option("--disturbed-weight", a->disturbed_weight, "with --via pdr: weight of a disturbed reading");
   c->add_flag("--no-declination", a->no_declination,
               "diagnostic, with --via pdr: no WMM (magnetic headings, no field tests)");
+  c->add_option("--non-qsf-weight", a->non_qsf_weight, "with --via pdr: weight of a reading outside a quasi-static field");
+  c->add_option("--qsf-std", a->qsf_std_deg, "with --via pdr: QSF offset std threshold, deg");
+  c->add_option("--qsf-field-std", a->qsf_field_std_ut, "with --via pdr: QSF |B| std threshold, uT");
+  c->add_option("--qsf-window", a->qsf_window_s, "with --via pdr: QSF window, s");
+  c->add_flag("--compass-only", a->compass_only, "with --via pdr: ignore the rotation vector (raw compass heading)");
   c->add_flag("--quiet", a->quiet, "one line per walk");
   c->add_flag("--legacy", a->legacy,
               "the engine as before issue 16 (chest mount, latest rotation vector, APT 1.75 m, no motion gate)");

@@ -16,39 +16,16 @@
 #include "pdnav/pdr/motion_classifier.h"
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/pdr/placement.h"
+#include "real_walk.h"
 #include "test_data.h"
 
 using namespace pdnav;
 using namespace pdnav::pdr;
+using pdnav::test::RealWalk;
+using pdnav::test::read_ilc;
+using pdnav::test::run;
 
 namespace {
-
-struct RealWalk {
-  std::vector<AccelSample> accel;
-  std::vector<GyroSample> gyro;
-  std::vector<RotationVectorSample> rotation;
-};
-
-/// The sensor lines of one ILC walk (tab-separated "unix_ms TYPE x y z [acc]").
-RealWalk read_ilc(const std::string& path) {
-  RealWalk w;
-  std::ifstream in(path);
-  EXPECT_TRUE(in.good()) << path;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream ss(line);
-    std::int64_t ms = 0;
-    std::string type;
-    double x = 0, y = 0, z = 0;
-    if (!(ss >> ms >> type >> x >> y >> z)) continue;
-    const TimeNs t = ms * 1'000'000;
-    if (type == "TYPE_ACCELEROMETER") w.accel.push_back({t, ms, {x, y, z}});
-    else if (type == "TYPE_GYROSCOPE") w.gyro.push_back({t, ms, {x, y, z}});
-    else if (type == "TYPE_ROTATION_VECTOR")
-      w.rotation.push_back({t, ms, {x, y, z, std::sqrt(std::max(0.0, 1 - x * x - y * y - z * z))}, kNaN});
-  }
-  return w;
-}
 
 const char* kWalk = "pdr-ilc2020/data/site2/F3/path_data_files/5dd38fff44333f00067aa387.txt";
 
@@ -100,23 +77,6 @@ RealWalk make_waving(const RealWalk& real, TimeNs t_end_ns, double seconds, std:
     w.gyro.push_back({t_ns, kMissingInt, rate});
   }
   return w;
-}
-
-std::vector<PdrStep> run(const PdrOptions& o, const RealWalk& a, const RealWalk* b = nullptr) {
-  Pdr p(o);
-  std::vector<PdrStep> out;
-  auto feed = [&](const RealWalk& w) {
-    std::size_t ig = 0, ir = 0;
-    for (const auto& s : w.accel) {
-      while (ig < w.gyro.size() && w.gyro[ig].t_ns <= s.t_ns) p.feed(w.gyro[ig++]);
-      while (ir < w.rotation.size() && w.rotation[ir].t_ns <= s.t_ns) p.feed(w.rotation[ir++]);
-      p.feed(s);
-      for (const auto& st : p.take_steps()) out.push_back(st);
-    }
-  };
-  feed(a);
-  if (b) feed(*b);
-  return out;
 }
 
 }  // namespace
@@ -260,17 +220,8 @@ TEST(PdrMotion, AndroidStepEventsWhileWavingAreRefused) {
   for (bool gate : {true, false}) {
     o.gate_handling = gate;
     Pdr p(o);
-    std::size_t ig = 0, counted = 0;
-    TimeNs next_event = waving.accel.front().t_ns + 2'000'000'000;
-    for (const auto& s : waving.accel) {
-      while (ig < waving.gyro.size() && waving.gyro[ig].t_ns <= s.t_ns) p.feed(waving.gyro[ig++]);
-      p.feed(s);
-      if (s.t_ns >= next_event) {
-        p.feed(StepDetectorSample{s.t_ns, kMissingInt});
-        next_event += 625'000'000;
-      }
-      counted += p.take_steps().size();
-    }
+    const std::size_t counted =
+        test::feed_with_step_events(p, waving, waving.accel.front().t_ns + 2'000'000'000, 625'000'000, false);
     if (gate) EXPECT_LE(counted, 2u);
     else EXPECT_GT(counted, 30u);  // the events are there: only the gate removes them
   }
@@ -366,4 +317,41 @@ TEST(PdrHeading, UnreliableMagnetometerAccuracyKeepsADisturbedRotationVectorFrom
   HeadingFusion h;
   EXPECT_DOUBLE_EQ(h.accuracy_weight(3), 1.0);
   EXPECT_DOUBLE_EQ(h.accuracy_weight(-1), h.accuracy_weight(0));
+}
+
+TEST(PdrHeadingFusion, QuasiStaticFieldIsFoundOnlyWhileTheFieldIsStillInTheGyroFrame) {
+  HeadingFusionOptions o;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  auto run_for = [&](QuasiStaticField& q, TimeNs& t, double seconds, double offset_rate_radps, double field_rate_utps,
+                     int& static_count) {
+    double offset = 1.0, field = 45.0;
+    static_count = 0;
+    const int n = static_cast<int>(seconds * 50);
+    for (int i = 0; i < n; ++i) {
+      t += 20'000'000;
+      offset += offset_rate_radps * 0.02;
+      field += field_rate_utps * 0.02;
+      q.add(t, offset + 0.5 * kDegToRad * n01(rng), field + 0.2 * n01(rng));
+      static_count += i >= 50 && q.quasi_static();  // after one window of the new behaviour
+    }
+  };
+  QuasiStaticField q(o);
+  TimeNs t = 0;
+  int n_static = 0;
+  for (int i = 0; i < 30; ++i) {
+    q.add(t += 20'000'000, 1.0, 45.0);
+    EXPECT_FALSE(q.quasi_static());  // less than 80 % of a window: not yet decided
+  }
+  run_for(q, t, 3.0, 0.0, 0.0, n_static);
+  EXPECT_EQ(n_static, 100);  // a still field: quasi-static (the 100 readings after the first window)
+  EXPECT_TRUE(q.quasi_static());
+  // walking past a steel pillar: the compass turns against the gyro by 20 deg/s
+  run_for(q, t, 3.0, 20.0 * kDegToRad, 0.0, n_static);
+  EXPECT_EQ(n_static, 0);
+  // the heading agrees but |B| changes by 8 uT/s (a field gradient)
+  run_for(q, t, 3.0, 0.0, 8.0, n_static);
+  EXPECT_EQ(n_static, 0);
+  // the default Pdr uses it: readings outside a quasi-static field are down-weighted
+  EXPECT_LT(HeadingFusionOptions{}.non_qsf_weight, 1.0);
 }

@@ -99,4 +99,25 @@ double HeadingFusion::sigma_rad() const {
   return std::clamp(opt_.base_sigma_rad / std::sqrt(n_independent), opt_.min_sigma_rad, kPi);
 }
 
+void QuasiStaticField::add(TimeNs t_ns, double offset_rad, double field_ut) {
+  if (!std::isfinite(offset_rad) || !std::isfinite(field_ut)) return;
+  if (!window_.empty() && t_ns <= window_.back().t_ns) return;
+  const TimeNs span_ns = s_to_ns(opt_.qsf_window_s);
+  if (!window_.empty() && t_ns - window_.back().t_ns > span_ns) window_.clear();  // a gap
+  window_.push_back({t_ns, offset_rad, field_ut});
+  std::size_t first = 0;
+  while (first < window_.size() && window_[first].t_ns < t_ns - span_ns) ++first;
+  window_.erase(window_.begin(), window_.begin() + static_cast<std::ptrdiff_t>(first));
+  qsf_ = false;
+  if (window_.size() < 3 || ns_to_s(t_ns - window_.front().t_ns) < 0.8 * opt_.qsf_window_s) return;
+  double c = 0, sn = 0, f = 0, f2 = 0;
+  for (const Reading& r : window_) c += std::cos(r.offset_rad), sn += std::sin(r.offset_rad), f += r.field_ut,
+                                    f2 += r.field_ut * r.field_ut;
+  const double n = static_cast<double>(window_.size());
+  const double resultant = std::min(1.0, std::hypot(c, sn) / n);
+  offset_std_rad_ = std::sqrt(std::max(0.0, -2.0 * std::log(std::max(resultant, 1e-12))));  // circular std
+  field_std_ut_ = std::sqrt(std::max(0.0, f2 / n - (f / n) * (f / n)));
+  qsf_ = offset_std_rad_ <= opt_.qsf_max_offset_std_rad && field_std_ut_ <= opt_.qsf_max_field_std_ut;
+}
+
 }  // namespace pdnav::pdr

@@ -12,6 +12,7 @@ const char* to_string(MotionState m) {
   switch (m) {
     case MotionState::kWalking: return "walking";
     case MotionState::kHandling: return "handling";
+    case MotionState::kVehicle: return "vehicle";
     case MotionState::kStanding: break;
   }
   return "standing";
@@ -26,6 +27,7 @@ void MotionClassifier::feed(const AccelSample& s) {
   acc_.emplace_back(s.t_ns, m);
   acc_sum_ += m;
   acc_sq_ += m * m;
+  vehicle_sample(s.t_ns, m, nullptr);
   const TimeNs horizon = s.t_ns - s_to_ns(opt_.window_s);
   while (!acc_.empty() && acc_.front().first <= horizon) {
     acc_sum_ -= acc_.front().second;
@@ -43,6 +45,7 @@ void MotionClassifier::feed(const AccelSample& s) {
 void MotionClassifier::feed(const GyroSample& s) {
   if (!s.rate_radps.allFinite() || (last_gyro_ns_ >= 0 && s.t_ns <= last_gyro_ns_)) return;
   last_gyro_ns_ = s.t_ns;
+  vehicle_sample(s.t_ns, kNaN, &s.rate_radps);
   gyro_.emplace_back(s.t_ns, s.rate_radps);
   gyro_outer_ += s.rate_radps * s.rate_radps.transpose();
   const TimeNs horizon = s.t_ns - s_to_ns(opt_.window_s);
@@ -82,6 +85,10 @@ void MotionClassifier::update(TimeNs t_ns) {
     return;
   }
   span_open_ = false;
+  if (vehicle_) {
+    state_ = MotionState::kVehicle;
+    return;
+  }
   double sigma = 0.0;
   if (acc_.size() >= 4) {
     const double n = static_cast<double>(acc_.size());
@@ -92,12 +99,116 @@ void MotionClassifier::update(TimeNs t_ns) {
   state_ = still ? MotionState::kStanding : MotionState::kWalking;
 }
 
-bool MotionClassifier::handling_at(TimeNs t_ns) const {
-  for (auto it = spans_.rbegin(); it != spans_.rend(); ++it) {
+namespace {
+bool inside(const std::deque<MotionSpan>& spans, TimeNs t_ns) {
+  for (auto it = spans.rbegin(); it != spans.rend(); ++it) {
     if (t_ns >= it->t_start_ns && t_ns <= it->t_end_ns) return true;
     if (it->t_end_ns < t_ns) break;
   }
   return false;
+}
+}  // namespace
+
+bool MotionClassifier::handling_at(TimeNs t_ns) const { return inside(spans_, t_ns); }
+
+bool MotionClassifier::vehicle_at(TimeNs t_ns) const { return inside(vehicle_spans_, t_ns); }
+
+void MotionClassifier::vehicle_sample(TimeNs t_ns, double acc_norm, const Eigen::Vector3d* gyro) {
+  if (!opt_.vehicle) return;
+  const TimeNs bin_ns = s_to_ns(opt_.vehicle_bin_s);
+  if (bin_origin_ns_ < 0) bin_origin_ns_ = t_ns;
+  const std::int64_t index = (t_ns - bin_origin_ns_) / bin_ns;
+  if (index < cur_bin_index_) return;  // the other sensor's older sample: ignore it here
+  if (cur_bin_index_ < 0) cur_bin_index_ = index;
+  if (index > cur_bin_index_) {
+    const std::size_t window_bins = static_cast<std::size_t>(std::lround(opt_.vehicle_window_s / opt_.vehicle_bin_s));
+    if (static_cast<double>(index - cur_bin_index_) * opt_.vehicle_bin_s > opt_.gyro_timeout_s) {
+      bins_.clear();  // a gap: the window restarts (the score and the state are kept)
+    } else {
+      for (std::int64_t k = cur_bin_index_; k < index; ++k) {
+        // an empty bin (a late sensor) repeats the previous mean so the lag grid stays uniform
+        Bin b = k == cur_bin_index_ ? cur_bin_ : Bin{};
+        if (b.n == 0 && !bins_.empty()) {
+          const Bin& p = bins_.back();
+          if (p.n > 0) b.n = 1, b.sum = p.sum / p.n, b.sq = b.sum * b.sum;
+        }
+        bins_.push_back(b);
+        if (bins_.size() > window_bins) bins_.pop_front();
+        if (++bins_since_eval_ * opt_.vehicle_bin_s >= opt_.vehicle_eval_s - 1e-9 && bins_.size() == window_bins) {
+          bins_since_eval_ = 0;
+          vehicle_evaluate(bin_origin_ns_ + (k + 1) * bin_ns);
+        }
+      }
+    }
+    cur_bin_ = Bin{};
+    cur_bin_index_ = index;
+  }
+  if (std::isfinite(acc_norm)) ++cur_bin_.n, cur_bin_.sum += acc_norm, cur_bin_.sq += acc_norm * acc_norm;
+  if (gyro != nullptr) ++cur_bin_.gyro_n, cur_bin_.gyro_sq += gyro->squaredNorm();
+}
+
+void MotionClassifier::vehicle_evaluate(TimeNs t_ns) {
+  const std::size_t n = bins_.size();
+  // 1 s sub-windows: sigma of the raw |a| samples
+  const std::size_t sub = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(1.0 / opt_.vehicle_bin_s)));
+  double min_sigma = 1e300, max_sigma = 0.0;
+  for (std::size_t a = 0; a + sub <= n; a += sub) {
+    double cnt = 0, sum = 0, sq = 0;
+    for (std::size_t i = a; i < a + sub; ++i) cnt += bins_[i].n, sum += bins_[i].sum, sq += bins_[i].sq;
+    const double sigma = cnt > 1 ? std::sqrt(std::max(0.0, sq / cnt - (sum / cnt) * (sum / cnt))) : 0.0;
+    min_sigma = std::min(min_sigma, sigma);
+    max_sigma = std::max(max_sigma, sigma);
+  }
+  // normalised (Pearson) autocorrelation of the bin means over the gait lags
+  std::vector<double> x(n);
+  for (std::size_t i = 0; i < n; ++i) x[i] = bins_[i].n > 0 ? bins_[i].sum / bins_[i].n : (i ? x[i - 1] : 0.0);
+  const auto lag_min = static_cast<std::size_t>(std::lround(opt_.gait_lag_min_s / opt_.vehicle_bin_s));
+  const auto lag_max = std::min(n - 2, static_cast<std::size_t>(std::lround(opt_.gait_lag_max_s / opt_.vehicle_bin_s)));
+  double corr = -1.0;
+  for (std::size_t lag = std::max<std::size_t>(1, lag_min); lag <= lag_max; ++lag) {
+    const std::size_t m = n - lag;
+    double ma = 0, mb = 0;
+    for (std::size_t i = 0; i < m; ++i) ma += x[i], mb += x[i + lag];
+    ma /= static_cast<double>(m);
+    mb /= static_cast<double>(m);
+    double ab = 0, aa = 0, bb = 0;
+    for (std::size_t i = 0; i < m; ++i) {
+      const double a = x[i] - ma, b = x[i + lag] - mb;
+      ab += a * b, aa += a * a, bb += b * b;
+    }
+    if (aa > 0 && bb > 0) corr = std::max(corr, ab / std::sqrt(aa * bb));
+  }
+  gait_corr_ = corr;
+  double gyro_cnt = 0, gyro_sq = 0;
+  for (const Bin& b : bins_) gyro_cnt += b.gyro_n, gyro_sq += b.gyro_sq;
+  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.gyro_timeout_s && gyro_cnt >= 4;
+  const double rate_rms = gyro_live ? std::sqrt(gyro_sq / gyro_cnt) : 0.0;
+
+  if (vehicle_) {
+    const bool gait = corr >= opt_.gait_exit_min && min_sigma >= opt_.gait_exit_sigma_mps2 &&
+                      (!gyro_live || rate_rms >= opt_.gait_exit_rate_radps);
+    if (gait) {
+      vehicle_ = false;
+      vehicle_score_s_ = 0.0;
+      vehicle_spans_.back().t_end_ns = std::max(vehicle_spans_.back().t_start_ns, t_ns - s_to_ns(opt_.vehicle_exit_lookback_s));
+    } else {
+      vehicle_spans_.back().t_end_ns = t_ns;
+    }
+    return;
+  }
+  const bool evidence = corr < opt_.aperiodic_max && min_sigma >= opt_.vehicle_min_sigma_mps2 &&
+                        max_sigma <= opt_.vehicle_max_sigma_mps2 && rate_rms <= opt_.vehicle_max_rate_radps;
+  if (evidence) {
+    if (vehicle_score_s_ <= 0.0) evidence_start_ns_ = t_ns - s_to_ns(opt_.vehicle_window_s);
+    vehicle_score_s_ += opt_.vehicle_eval_s;
+  } else {
+    vehicle_score_s_ = std::max(0.0, vehicle_score_s_ - opt_.vehicle_decay * opt_.vehicle_eval_s);
+  }
+  if (vehicle_score_s_ >= opt_.vehicle_enter_s) {
+    vehicle_ = true;
+    vehicle_spans_.push_back(MotionSpan{evidence_start_ns_, t_ns, MotionState::kVehicle});
+    if (vehicle_spans_.size() > 256) vehicle_spans_.pop_front();
+  }
 }
 
 }  // namespace pdnav::pdr

@@ -17,7 +17,8 @@ Pdr::Pdr(const PdrOptions& options)
       tracker_(options.heading.turn),
       classifier_(options.motion),
       placement_(options.placement),
-      fusion_(options.fusion) {}
+      fusion_(options.fusion),
+      qsf_(options.fusion) {}
 
 void Pdr::set_location(const geo::Geodetic& where, std::int64_t utc_ms) {
   const geo::Declination d = geo::declination_at(where, utc_ms);
@@ -43,6 +44,7 @@ void Pdr::sync_placement() {
   placement_revision_ = placement_.revision();
   // a new placement bout: the reference axis may have changed, restart the offset (auto only)
   if (opt_.heading.mount == Mount::kAuto) fusion_.reset();
+  qsf_.reset();  // the offset refers to the reference axis
 }
 
 void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight) {
@@ -57,10 +59,12 @@ void Pdr::feed(const AccelSample& s) {
   tracker_.feed(s);
   classifier_.feed(s);
   const bool handling = opt_.gate_handling && classifier_.state() == MotionState::kHandling;
-  if (handling) placement_.end_bout();  // the phone is being moved: re-estimate afterwards
+  const bool riding = opt_.gate_vehicle && classifier_.in_vehicle();
+  if (handling || riding) placement_.end_bout();  // the phone is being moved: re-estimate afterwards
   else placement_.feed(s, gate_.in_bout() || gate_.pending() > 0);  // first steps teach it too
   sync_placement();
   flush_undecided(s.t_ns, false);
+  settle_vehicle_wait(s.t_ns, false);
   // two steps between pauses count as a walk only while the handling gate can refuse jolts
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(s.t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
   gate_.set_short_walk_min_steps(opt_.gate_handling && gyro_live ? opt_.detector.short_walk_min_steps_gyro
@@ -116,6 +120,39 @@ Pdr::HeldStep Pdr::reprojected(HeldStep h) const {
 }
 
 void Pdr::deliver(HeldStep h, TimeNs now_ns) {
+  if (vehicle_gated()) {
+    vehicle_wait_.push_back(h);
+    return;
+  }
+  deliver_walking(h, now_ns);
+}
+
+void Pdr::settle_vehicle_wait(TimeNs now_ns, bool force) {
+  if (vehicle_wait_.empty()) return;
+  if (classifier_.in_vehicle()) {
+    // a step older than the exit look-back will be inside the span whenever it ends
+    const TimeNs keep_ns = now_ns - s_to_ns(opt_.motion.vehicle_exit_lookback_s);
+    while (!vehicle_wait_.empty() && (force || vehicle_wait_.front().candidate.t_ns < keep_ns)) {
+      ++counters_.steps_discarded_by_vehicle;
+      vehicle_wait_.pop_front();
+    }
+    return;
+  }
+  if (classifier_.vehicle_suspect() && !force) return;
+  std::deque<HeldStep> waiting;
+  waiting.swap(vehicle_wait_);
+  for (auto& h : waiting) {
+    if (classifier_.vehicle_at(h.candidate.t_ns)) {
+      ++counters_.steps_discarded_by_vehicle;
+    } else if (h.android) {
+      emit_step(h);
+    } else {
+      deliver_walking(h, now_ns);
+    }
+  }
+}
+
+void Pdr::deliver_walking(HeldStep h, TimeNs now_ns) {
   const bool wait = opt_.heading.mount == Mount::kAuto && opt_.placement.max_direction_wait_s > 0.0 &&
                     h.placement_revision == placement_.revision() && !placement_.direction_known();
   if (wait) {
@@ -148,6 +185,7 @@ void Pdr::release(const std::vector<HeldStep>& steps, TimeNs now_ns) {
 
 void Pdr::finish() {
   release(gate_.finish(), latest_ns_);
+  settle_vehicle_wait(latest_ns_, true);
   flush_undecided(latest_ns_, true);
 }
 
@@ -167,11 +205,20 @@ void Pdr::feed(const MagSample& s) {
   last_field_ut_ = s.field_ut;
   latest_ns_ = std::max(latest_ns_, s.t_ns);
   if (!tracker_.has_gravity()) return;
-  if (have_rv_ && ns_to_s(s.t_ns - last_rv_ns_) <= opt_.heading.rv_max_age_s) return;  // RV wins
   const auto compass =
       compass_heading_rad(s.field_ut, tracker_.up_phone(), reference_axis(), opt_.heading.min_horizontal);
+  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(s.t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
+  if (compass && gyro_live) {
+    qsf_.add(s.t_ns, *compass + tracker_.yaw_rad(), s.field_ut.norm());
+    ++counters_.mag_readings_qsf_tested;
+    counters_.mag_readings_quasi_static += qsf_.quasi_static();
+  } else {
+    qsf_.reset();
+  }  // no gyro frame to test the field's stationarity in
+  if (have_rv_ && ns_to_s(s.t_ns - last_rv_ns_) <= opt_.heading.rv_max_age_s) return;  // RV wins
   if (!compass) return;
-  absolute_heading(s.t_ns, *compass, mag_accuracy_weight_ * fusion_.field_weight(s.field_ut, tracker_.up_phone()));
+  absolute_heading(s.t_ns, *compass,
+                   qsf_weight() * mag_accuracy_weight_ * fusion_.field_weight(s.field_ut, tracker_.up_phone()));
 }
 
 void Pdr::feed(const SensorAccuracySample& s) {
@@ -195,6 +242,7 @@ void Pdr::feed(const RotationVectorSample& s) {
   const bool mag_fresh = have_mag_last_ && ns_to_s(s.t_ns - mag_last_ns_) <= opt_.heading.rv_max_age_s;
   double w = mag_fresh && tracker_.has_gravity() ? fusion_.field_weight(last_field_ut_, tracker_.up_phone()) : 1.0;
   w *= mag_accuracy_weight_;
+  if (mag_fresh) w *= qsf_weight();  // the RV used this field: trusted only while it is quasi-static
   // the sensor's own heading accuracy (when it reports one): inverse-variance relative to one
   // nominal reading, never above it
   if (std::isfinite(s.heading_accuracy_rad) && s.heading_accuracy_rad > 0.0)
@@ -215,6 +263,10 @@ void Pdr::feed(const StepDetectorSample& s) {
     ++counters_.steps_discarded_by_motion;  // the phone's own detector counts waving too
     return;
   }
+  if (opt_.gate_vehicle && classifier_.in_vehicle()) {
+    ++counters_.steps_discarded_by_vehicle;  // a phone's step detector fires on bumps too
+    return;
+  }
   if (opt_.source == StepSource::kAndroid || opt_.source == StepSource::kAuto) {
     // the swing of the accelerometer's own latest step (within 2 s), else the model's fallback
     const bool fresh = last_swing_ns_ >= 0 && std::abs(ns_to_s(s.t_ns - last_swing_ns_)) <= 2.0;
@@ -222,7 +274,10 @@ void Pdr::feed(const StepDetectorSample& s) {
     event.t_ns = s.t_ns;
     event.swing_mps2 = fresh ? last_swing_mps2_ : kNaN;
     event.interval_s = 0.0;  // unknown: the length model's cadence fallback
-    emit_step(hold(event));
+    HeldStep h = hold(event);
+    h.android = true;
+    if (vehicle_gated()) vehicle_wait_.push_back(h);
+    else emit_step(h);
   }
   trim_consistency(s.t_ns);
 }

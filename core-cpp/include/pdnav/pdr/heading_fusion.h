@@ -13,6 +13,7 @@
 // metres of walking averages the disturbances out, the gyro keeps the shape of the path.
 #pragma once
 #include <cstdint>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -42,6 +43,39 @@ struct HeadingFusionOptions {
   // uncalibrated compass is tens of degrees off, so such readings count as disturbed ones.
   // Multipliers of a reading's weight for accuracy 0..3 (below 0 = unreliable); no event = 1.
   double accuracy_weight[4] = {0.05, 0.25, 0.6, 1.0};
+  // Quasi-static field (QSF) detection after Afzal, Renaudin, Lachapelle, "Use of Earth's
+  // magnetic field for mitigating gyroscope errors regardless of magnetic perturbation",
+  // Sensors 11(12), 2011: the field is trusted for heading only while it is stationary in the
+  // gyro-propagated frame, i.e. while the compass heading + the integrated gyro yaw (the offset
+  // c) and |B| stay constant over qsf_window_s. Outside a QSF window a reading's weight is
+  // multiplied by non_qsf_weight (1 = detector off). Thresholds: docs/pdr.md ("Quasi-static field").
+  double qsf_window_s = 1.0;
+  double qsf_max_offset_std_rad = 3.0 * kDegToRad;
+  double qsf_max_field_std_ut = 1.0;
+  double non_qsf_weight = 0.1;
+};
+
+/// Quasi-static field detector (options in HeadingFusionOptions, qsf_*).
+class QuasiStaticField {
+ public:
+  explicit QuasiStaticField(const HeadingFusionOptions& options = {}) : opt_(options) {}
+  /// One magnetometer reading: offset = compass heading of the reference axis + gyro yaw, and |B|.
+  void add(TimeNs t_ns, double offset_rad, double field_ut);
+  void reset() { window_.clear(); }
+  /// The last window_s of readings (>= 80 % covered) have a stationary offset and |B|.
+  bool quasi_static() const { return qsf_; }
+  double offset_std_rad() const { return offset_std_rad_; }
+  double field_std_ut() const { return field_std_ut_; }
+
+ private:
+  struct Reading {
+    TimeNs t_ns;
+    double offset_rad, field_ut;
+  };
+  HeadingFusionOptions opt_;
+  std::vector<Reading> window_;
+  bool qsf_ = false;
+  double offset_std_rad_ = kNaN, field_std_ut_ = kNaN;
 };
 
 class HeadingFusion {

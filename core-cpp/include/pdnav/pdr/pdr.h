@@ -35,6 +35,8 @@ struct PdrOptions {
   PlacementOptions placement;    // placement + walking direction when heading.mount == kAuto
   MotionClassifierOptions motion;  // walking / standing / handling
   bool gate_handling = true;     // no steps while the phone is handled or waved
+  bool gate_vehicle = true;      // no steps while riding (motion.vehicle must be on); steps
+                                 // wait while vehicle evidence accumulates (docs/pdr.md)
   StepSource source = StepSource::kAccelerometer;
   double android_timeout_s = 3.0;
   /// Consistency check: the two step sources agree when their counts differ by at most this
@@ -52,8 +54,11 @@ struct PdrCounters {
   SampleCounters step_detector;
   std::int64_t steps_discarded_by_bout_gate = 0;
   std::int64_t steps_discarded_by_motion = 0;  // candidates while the phone was handled/waved
+  std::int64_t steps_discarded_by_vehicle = 0;  // steps inside a vehicle span (car, bus, train)
   std::int64_t mag_readings_trusted = 0;       // absolute headings that passed the WMM tests
   std::int64_t mag_readings_disturbed = 0;     // ... and that failed them (down-weighted)
+  std::int64_t mag_readings_qsf_tested = 0;    // magnetometer readings tested for a quasi-static field
+  std::int64_t mag_readings_quasi_static = 0;  // ... and found quasi-static (full weight)
   std::int64_t total_skipped() const {
     return accel.skipped() + gyro.skipped() + mag.skipped() + rotation_vector.skipped() + step_detector.skipped();
   }
@@ -139,12 +144,20 @@ class Pdr {
     double offset_rad = 0.0;               // placement offset (reference axis -> walking) used
     std::int64_t placement_revision = -1;  // placement bout it was taken in (or the next one)
     Eigen::Vector3d reference_phone = Eigen::Vector3d::Zero();  // axis its heading refers to
+    bool android = false;  // an Android step-detector event (emitted directly, no placement wait)
   };
   HeldStep hold(const StepCandidate& c) const;
   void release(const std::vector<HeldStep>& steps, TimeNs now_ns);
   /// Emits a released step, or holds it while its placement bout's walking direction is
   /// still the prior (first steps); the held ones are re-projected when it is decided.
   void deliver(HeldStep h, TimeNs now_ns);
+  void deliver_walking(HeldStep h, TimeNs now_ns);
+  /// Steps held while vehicle evidence accumulates: dropped inside a vehicle span, delivered
+  /// once the evidence is gone (or at the end of the input).
+  void settle_vehicle_wait(TimeNs now_ns, bool force);
+  bool vehicle_gated() const {
+    return opt_.gate_vehicle && (classifier_.in_vehicle() || classifier_.vehicle_suspect());
+  }
   void flush_undecided(TimeNs now_ns, bool force);
   HeldStep reprojected(HeldStep h) const;
   void emit_step(const HeldStep& h);
@@ -159,8 +172,11 @@ class Pdr {
   BoutGate<HeldStep> gate_;
   GyroTurnTracker tracker_;
   MotionClassifier classifier_;
+  std::deque<HeldStep> vehicle_wait_;
   PlacementEstimator placement_;
   HeadingFusion fusion_;
+  QuasiStaticField qsf_;
+  double qsf_weight() const { return qsf_.quasi_static() ? 1.0 : opt_.fusion.non_qsf_weight; }
   std::int64_t placement_revision_ = 0;
   Eigen::Vector3d last_field_ut_ = Eigen::Vector3d::Zero();
   double mag_accuracy_weight_ = 1.0;  // no accuracy event yet: readings keep their own weight
