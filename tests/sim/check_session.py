@@ -113,6 +113,12 @@ def main(argv):
         failures.append("replay gave no error statistics against the Truth rows")
     elif not summary["errors"]["drms_m"] < 100.0:
         failures.append(f"replay DRMS {summary['errors']['drms_m']} m")
+    pdr = summary.get("pdr", {})
+    for key in ("steps", "distance_m", "placements", "steps_refused_handling", "steps_refused_vehicle", "vehicle_spans"):
+        if key not in pdr:
+            failures.append(f"summary.json pdr has no '{key}'")
+    if pdr.get("vehicle_spans"):
+        failures.append(f"a simulated walk was classed as riding a vehicle: {pdr['vehicle_spans']}")
     if summary.get("skipped_lines_by_reason"):
         failures.append(f"the reader skipped lines: {summary['skipped_lines_by_reason']}")
     if failures:

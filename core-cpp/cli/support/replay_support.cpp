@@ -265,6 +265,11 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
   const pdr::PdrCounters c = pdr.counters();
   j["steps_refused_handling"] = c.steps_discarded_by_motion;
   j["steps_dropped_by_bout_gate"] = c.steps_discarded_by_bout_gate;
+  j["steps_refused_vehicle"] = c.steps_discarded_by_vehicle;
+  nlohmann::json rides = nlohmann::json::array();
+  for (const pdr::MotionSpan& v : pdr.vehicle_spans())
+    rides.push_back({{"start_s", ns_to_s(v.t_start_ns - t0_ns)}, {"end_s", ns_to_s(v.t_end_ns - t0_ns)}});
+  j["vehicle_spans"] = rides;
   j["magnetometer_readings_trusted"] = c.mag_readings_trusted;
   j["magnetometer_readings_disturbed"] = c.mag_readings_disturbed;
   nlohmann::json bouts = nlohmann::json::array();

@@ -130,6 +130,10 @@ class Pdr {
   /// Placement bouts so far (time spans, placement, walking direction in phone axes); with a
   /// declared mount one bout per gravity-stable span, walking direction = the mount's axis.
   std::vector<PlacementBout> placements() const { return placement_.bouts(); }
+  /// Vehicle spans found by the motion classifier (the latest 256; the open one included).
+  std::vector<MotionSpan> vehicle_spans() const {
+    return {classifier_.vehicle_spans().begin(), classifier_.vehicle_spans().end()};
+  }
   MotionState motion_state() const { return classifier_.state(); }
   /// Sum of the emitted step lengths (m).
   double distance_m() const { return distance_m_; }
