@@ -126,7 +126,7 @@ struct GnssEngine::Impl {
       if (!sat_state(m, ep.rx, st)) continue;
       if (m.code_ok()) {
         sm_in.push_back(SmoothingInput{m.sat, m.pseudorange_m, m.adr_ok() ? m.adr_m : kNaN, m.pr_rate_mps, m.iono_free,
-                                       m.pseudorange_l1_m, m.iono_free ? SignalBand::kL1 : signal_band(m.carrier_hz)});
+                                       m.pseudorange_l1_m, code_band(m.iono_free, m.carrier_hz)});
         spp_obs.push_back(SppObservation{m.sat, m.pseudorange_m, m.cn0_dbhz, carrier_hz(m, st), st, m.iono_free, 1.0,
                                          m.iono_free ? m.cn0_l5_dbhz : kNaN});
       }

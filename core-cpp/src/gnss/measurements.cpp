@@ -163,6 +163,14 @@ void drop_duplicates(std::vector<Measurement>& meas, ExclusionCounts& excluded) 
   meas.swap(out);
 }
 
+bool supported(Constellation c) {
+  return c == Constellation::kGps || c == Constellation::kGlonass || c == Constellation::kGalileo ||
+         c == Constellation::kBeidou || c == Constellation::kQzss;
+}
+
+/// Receiver-clock group (QZSS is steered to GPS time and shares its clock, as in spp.h).
+Constellation dual_group(Constellation sys) { return sys == Constellation::kQzss ? Constellation::kGps : sys; }
+
 /// FrequencyMode::kBest: in a clock group with at least `min_sats` usable L5/E5a/B2a codes,
 /// every such satellite is measured on that band (code, Doppler, carrier); the others keep L1.
 /// A group with fewer L5 codes stays on L1: its L5 clock (the receiver's L1-L5 bias, one more
@@ -171,9 +179,9 @@ void use_best_band(std::vector<Measurement>& meas, std::vector<Measurement>& l5,
                    ExclusionCounts& excluded) {
   drop_duplicates(l5, excluded);
   std::map<Constellation, int> per_group;
-  for (const Measurement& s5 : l5) ++per_group[s5.sat.sys == Constellation::kQzss ? Constellation::kGps : s5.sat.sys];
+  for (const Measurement& s5 : l5) ++per_group[dual_group(s5.sat.sys)];
   for (const Measurement& s5 : l5) {
-    if (per_group[s5.sat.sys == Constellation::kQzss ? Constellation::kGps : s5.sat.sys] < min_sats) {
+    if (per_group[dual_group(s5.sat.sys)] < min_sats) {
       ++excluded["best: too few L5/E5a codes in the clock group (L1 kept)"];
       continue;
     }
@@ -187,14 +195,6 @@ void use_best_band(std::vector<Measurement>& meas, std::vector<Measurement>& l5,
     }
   }
 }
-
-bool supported(Constellation c) {
-  return c == Constellation::kGps || c == Constellation::kGlonass || c == Constellation::kGalileo ||
-         c == Constellation::kBeidou || c == Constellation::kQzss;
-}
-
-/// Receiver-clock group (QZSS is steered to GPS time and shares its clock, as in spp.h).
-Constellation dual_group(Constellation sys) { return sys == Constellation::kQzss ? Constellation::kGps : sys; }
 
 double median_of(std::vector<double> v) {
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);

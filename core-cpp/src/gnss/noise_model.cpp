@@ -11,6 +11,10 @@ SignalBand signal_band(double carrier_hz) {
   return std::isfinite(carrier_hz) && carrier_hz < 1.3e9 ? SignalBand::kL5 : SignalBand::kL1;
 }
 
+SignalBand code_band(bool iono_free, double carrier_hz) {
+  return iono_free ? SignalBand::kL1 : signal_band(carrier_hz);
+}
+
 const char* to_string(SignalBand b) { return b == SignalBand::kL5 ? "L5" : "L1"; }
 
 CodeNoiseModel CodeNoiseModel::uniform(double a_m2, double b_m2hz) {
@@ -42,7 +46,7 @@ double CodeNoiseModel::variance_m2(Constellation sys, double carrier_hz, double 
 
 double CodeNoiseModel::zenith_variance_m2(Constellation sys, SignalBand band, double cn0_dbhz) const {
   const CodeNoiseParams& p = params(sys, band);
-  return p.a_m2 + p.b_m2hz * std::pow(10.0, -cn0_dbhz / 10.0);
+  return cn0_elevation_variance(p.a_m2, p.b_m2hz, cn0_dbhz, kPi / 2);
 }
 
 double iono_free_variance_m2(const CodeNoiseModel& m, Constellation sys, double cn0_l1_dbhz, double cn0_l5_dbhz,

@@ -41,8 +41,7 @@ Constellation clock_group(Constellation sys) {
 namespace {
 
 ClockKey clock_key(const SppObservation& o) {
-  // an ionosphere-free code is on the L1 clock (measurements.h combine_dual_frequency)
-  return ClockKey{clock_group(o.sat.sys), o.iono_free ? SignalBand::kL1 : signal_band(o.carrier_hz)};
+  return ClockKey{clock_group(o.sat.sys), code_band(o.iono_free, o.carrier_hz)};
 }
 
 Layout make_layout(const std::vector<const SppObservation*>& obs) {
@@ -395,10 +394,13 @@ std::vector<TruthResidual> residuals_at_truth(const std::vector<SppObservation>&
     y(k) = t.residual_m;
   }
   // least absolute deviations by iteratively reweighted least squares (w = 1 / max(|e|, 0.1 m)):
-  // the clocks follow the median satellite, not the multipath tails
-  for (int pass = 0; pass < 20; ++pass) {
+  // the clocks follow the median satellite, not the multipath tails; 20 reweightings, then the
+  // solution with the last weights
+  Eigen::VectorXd sol;
+  for (int pass = 0;; ++pass) {
     const Eigen::MatrixXd hw = w.asDiagonal() * h;
-    const Eigen::VectorXd sol = (h.transpose() * hw).ldlt().solve(hw.transpose() * y);
+    sol = (h.transpose() * hw).ldlt().solve(hw.transpose() * y);
+    if (pass == 20) break;
     e = y - h * sol;
     for (int k = 0; k < n; ++k) w(k) = 1.0 / std::max(std::fabs(e(k)), 0.1);
   }
@@ -407,11 +409,7 @@ std::vector<TruthResidual> residuals_at_truth(const std::vector<SppObservation>&
   // the median adds is divided out: var(median of m) = sigma^2 / 2 for m = 2, ~pi sigma^2 / (2 m)
   // beyond (Kenney & Keeping 1962, the median's asymptotic variance).
   Eigen::VectorXd yh = y;
-  if (ropt.estimate_height) {
-    const Eigen::MatrixXd hw = w.asDiagonal() * h;
-    const Eigen::VectorXd sol = (h.transpose() * hw).ldlt().solve(hw.transpose() * y);
-    yh -= h.col(p - 1) * sol(p - 1);
-  }
+  if (ropt.estimate_height) yh -= h.col(p - 1) * sol(p - 1);
   std::vector<TruthResidual> kept;
   for (int k = 0; k < n; ++k) {
     TruthResidual t = out[rows[static_cast<std::size_t>(k)]];

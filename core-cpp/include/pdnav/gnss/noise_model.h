@@ -13,6 +13,9 @@ namespace pdnav::gnss {
 /// BeiDou B2a (1176.45 MHz). A carrier below 1.3 GHz is L5; an unknown (NaN) carrier is L1.
 enum class SignalBand : int { kL1 = 0, kL5 = 1 };
 SignalBand signal_band(double carrier_hz);
+/// The band a code is on for its receiver clock and smoothing: an ionosphere-free L1/L5 code is
+/// formed on the L1 clock (measurements.h combine_dual_frequency), any other code on its carrier's.
+SignalBand code_band(bool iono_free, double carrier_hz);
 const char* to_string(SignalBand b);
 
 struct CodeNoiseParams {
