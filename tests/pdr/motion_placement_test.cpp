@@ -1,7 +1,9 @@
 // Issue 16: the motion classifier (no steps from a waved phone), placement / walking direction
 // without a declared mount, the gyro-dominant heading with WMM-gated magnetic readings, and the
 // step-length models. Real data: one ILC 2020 hand-held walk (../shared/data/pdr-ilc2020).
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -189,6 +191,48 @@ TEST(PdrHeadingFusion, DisturbedReadingsBarelyMoveTheGyroHeading) {
   for (int i = 0; i < 1000; ++i) trusting.add(i * 20'000'000LL, 30 * kDegToRad, 0.0, 1.0, true);
   for (int i = 1000; i < 1500; ++i) trusting.add(i * 20'000'000LL, 90 * kDegToRad, 0.0, 1.0, true);
   EXPECT_GT(std::abs(wrap_pi(trusting.heading_mag_rad(0.0, 1500 * 20000000LL) - 30 * kDegToRad)), 10 * kDegToRad);
+}
+
+/// The drift HeadingFusion estimates from 30 s of 50 Hz readings whose offset c (heading + gyro
+/// yaw) is a ramp of drift_dps plus a field disturbance: a smooth random process with the
+/// given std and correlation time (first-order Gauss-Markov, seeded), as walking through a
+/// mall's field gives, plus 0.5 deg of white compass noise.
+double drift_learned_dps(const HeadingFusionOptions& opt, double drift_dps, double disturbance_deg,
+                         double correlation_s, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  HeadingFusion h(opt);
+  const double dt = 0.02, phi = std::exp(-dt / correlation_s);
+  double d = disturbance_deg * n01(rng);
+  for (int i = 0; i <= 1500; ++i) {
+    const double t = i * dt;
+    d = phi * d + disturbance_deg * std::sqrt(1 - phi * phi) * n01(rng);
+    const double c_deg = 40.0 + drift_dps * t + d + 0.5 * n01(rng);
+    h.add(s_to_ns(t), wrap_two_pi(c_deg * kDegToRad), 0.0, 1.0, true);
+  }
+  return h.drift_radps() / kDegToRad;
+}
+
+TEST(PdrHeadingFusion, GyroDriftIsLearnedFromACleanFieldNotFromADisturbedOne) {
+  // A calibrated gyro drifts < 0.1 deg/s; a field that changes along the walk makes the offset
+  // wander by degrees over seconds (ILC: +-2 deg/s apparent slopes on short walks). The drift
+  // prior (drift_prior_sigma_radps) must keep the second out of the drift and still learn a
+  // real 0.4 deg/s bias when the field is clean.
+  const HeadingFusionOptions def;
+  HeadingFusionOptions no_prior;  // the ridge floor alone (the fusion before this prior)
+  no_prior.drift_prior_sigma_radps = 0.0;
+  no_prior.drift_tau_s = no_prior.tau_s;
+  double worst_disturbed = 0, worst_disturbed_no_prior = 0, worst_clean_error = 0;
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    worst_clean_error = std::max(worst_clean_error, std::abs(drift_learned_dps(def, 0.4, 0.0, 8.0, seed) - 0.4));
+    worst_disturbed = std::max(worst_disturbed, std::abs(drift_learned_dps(def, 0.0, 8.0, 8.0, seed)));
+    worst_disturbed_no_prior = std::max(worst_disturbed_no_prior, std::abs(drift_learned_dps(no_prior, 0.0, 8.0, 8.0, seed)));
+  }
+  std::printf("clean 0.4 deg/s: worst error %.3f deg/s; disturbed 8 deg, no drift: worst %.3f deg/s (without the prior %.3f)\n",
+              worst_clean_error, worst_disturbed, worst_disturbed_no_prior);
+  EXPECT_LT(worst_clean_error, 0.12);  // >= 70 % of the bias after 30 s (the 5 s ridge floor shrinks it)
+  EXPECT_LT(worst_disturbed, 0.15);
+  EXPECT_GT(worst_disturbed_no_prior, 0.3);  // the defect the prior removes
 }
 
 TEST(PdrStepLength, FrequencyModelAndLearnedScale) {

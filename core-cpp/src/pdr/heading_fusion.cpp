@@ -34,7 +34,7 @@ void HeadingFusion::LineSums::shift_and_decay(double dt_s, double decay) {
   s2 = s2 - 2.0 * dt_s * s1 + dt_s * dt_s * s0;
   s1 = s1 - dt_s * s0;
   y1 = y1 - dt_s * y0;
-  s0 *= decay, s1 *= decay, s2 *= decay, y0 *= decay, y1 *= decay;
+  s0 *= decay, s1 *= decay, s2 *= decay, y0 *= decay, y1 *= decay, yy *= decay;
 }
 
 void HeadingFusion::add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, double weight, bool gyro_live) {
@@ -51,7 +51,7 @@ void HeadingFusion::add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, dou
     const double decay = std::exp(-dt_s / (gyro_live ? opt_.tau_s : opt_.no_gyro_tau_s));
     all_.shift_and_decay(dt_s, decay);
     circ_ *= decay;
-    trusted_.shift_and_decay(dt_s, decay);
+    trusted_.shift_and_decay(dt_s, gyro_live ? std::exp(-dt_s / opt_.drift_tau_s) : decay);
     weight_s_ = weight_s_ * decay + weight * std::min(1.0, dt_s);
   }
   have_last_ = true;
@@ -70,10 +70,17 @@ void HeadingFusion::add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, dou
 double HeadingFusion::drift_radps() const {
   const LineSums& t = trusted_;
   if (!(t.s0 > 0.0)) return 0.0;
-  const double mt = t.s1 / t.s0;
+  const double mt = t.s1 / t.s0, my = t.y0 / t.s0;
   const double var_t = std::max(0.0, t.s2 / t.s0 - mt * mt);
-  const double cov_ty = t.y1 / t.s0 - mt * (t.y0 / t.s0);
-  const double b = cov_ty / (var_t + opt_.drift_prior_s * opt_.drift_prior_s);
+  const double cov_ty = t.y1 / t.s0 - mt * my;
+  // scatter of the offsets about the fitted line, and how many of them are independent
+  const double var_y = std::max(0.0, t.yy / t.s0 - my * my);
+  const double resid = var_t > 0.0 ? std::max(0.0, var_y - cov_ty * cov_ty / var_t) : var_y;
+  const double n_independent = std::max(1.0, std::sqrt(12.0 * var_t) / opt_.decorrelation_s);
+  const double sigma_b = opt_.drift_prior_sigma_radps;
+  const double ridge = std::max(opt_.drift_prior_s * opt_.drift_prior_s,
+                                sigma_b > 0.0 ? resid / (sigma_b * sigma_b * n_independent) : 0.0);
+  const double b = cov_ty / (var_t + ridge);
   return std::clamp(b, -opt_.max_drift_radps, opt_.max_drift_radps);
 }
 

@@ -67,8 +67,10 @@ void Pdr::feed(const AccelSample& s) {
   settle_vehicle_wait(s.t_ns, false);
   // two steps between pauses count as a walk only while the handling gate can refuse jolts
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(s.t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
-  gate_.set_short_walk_min_steps(opt_.gate_handling && gyro_live ? opt_.detector.short_walk_min_steps_gyro
-                                                                 : opt_.detector.short_walk_min_steps);
+  const bool gyro_gate = opt_.gate_handling && gyro_live;
+  gate_.set_short_walk_min_steps(gyro_gate ? opt_.detector.short_walk_min_steps_gyro : opt_.detector.short_walk_min_steps);
+  gate_.set_min_steps(gyro_gate && opt_.detector.bout_min_steps_gyro > 0 ? opt_.detector.bout_min_steps_gyro
+                                                                         : opt_.detector.bout_min_steps);
   const auto candidates = detector_.feed(s);
   if (detector_.counters().gaps != gaps_seen_) {  // a gap resets the detector and the bout
     gaps_seen_ = detector_.counters().gaps;

@@ -39,6 +39,7 @@ StepDetectorOptions StepDetectorOptions::paper() {
   o.bout_min_steps = 1;
   o.short_walk_min_steps = 0;
   o.short_walk_min_steps_gyro = 0;
+  o.bout_min_steps_gyro = 0;
   o.stride_harmonic_ratio = 0.0;
   return o;
 }

@@ -32,7 +32,17 @@ struct HeadingFusionOptions {
   double decorrelation_s = 5.0;           // readings closer than this are not independent
   double min_sigma_rad = 3 * kDegToRad;
   double max_drift_radps = 1.0 * kDegToRad;  // |estimated gyro yaw drift| at most (MEMS: < 0.5 deg/s)
-  double drift_prior_s = 5.0;             // ridge on the drift: time spread needed to trust it
+  // The drift is a property of the gyro (stable for minutes, small on a platform-calibrated
+  // gyro); a field that changes along the walk looks like drift over tens of seconds (ILC:
+  // offset slopes of +-2 deg/s on 10-60 s walks, opposite signs on consecutive walks of one
+  // phone, |slope| median 0.05 deg/s over the 100 s ones). So the drift has its own long memory
+  // and a Bayesian prior N(0, drift_prior_sigma^2): the slope of a weighted line with residual
+  // scatter s over n independent readings is shrunk by the ridge s^2 / (sigma^2 n) (at least
+  // drift_prior_s^2): a clean field teaches it in seconds, a disturbed one needs minutes
+  // (docs/pdr.md "Gyro drift").
+  double drift_tau_s = 600.0;                       // memory of the drift fit
+  double drift_prior_sigma_radps = 0.1 * kDegToRad;  // residual bias of a calibrated MEMS gyro
+  double drift_prior_s = 5.0;                       // ridge floor: time spread needed to trust it
   // Consistency: mean resultant length of the offsets (1 = all agree). Below this the gyro and
   // the absolute readings contradict each other (e.g. a heading that flips 180 deg while the
   // gyro is still): the offset is unknown, the latest reading is followed (the pre-fusion
@@ -106,9 +116,9 @@ class HeadingFusion {
   // decayed weighted sums of the line fit y = a + b tau, tau = t - last_ns_ (re-anchored at
   // every reading), y = offset unwrapped around anchor_rad_
   struct LineSums {
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0, y0 = 0.0, y1 = 0.0;
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, y0 = 0.0, y1 = 0.0, yy = 0.0;
     void shift_and_decay(double dt_s, double decay);
-    void add(double w, double y) { s0 += w, y0 += w * y; }  // at tau = 0
+    void add(double w, double y) { s0 += w, y0 += w * y, yy += w * y * y; }  // at tau = 0
   };
   double anchor_rad_ = 0.0;
   LineSums all_;      // every reading: the offset
