@@ -31,6 +31,7 @@
 #include "pdnav/geo/wmm.h"
 #include "pdnav/io/log_reader.h"
 #include "pdnav/pdr/pdr.h"
+#include "pdnav/phonesim/handling.h"
 
 namespace pdnav::cli {
 namespace {
@@ -53,6 +54,9 @@ struct EvalPdrArgs {
   double qsf_field_std_ut = kNaN;
   double qsf_window_s = kNaN;
   bool compass_only = false;  // diagnostic (--via pdr): no rotation vector, heading from the raw compass
+  double wave_s = 0.0;        // seconds of synthesised calibration waving at the start point (0 = none)
+  std::uint64_t wave_seed = 1;
+  double wave_amplitude = 1.0;
 };
 
 /// The naive reference PDR of the issue: low-passed |a| peaks, fixed 0.70 m, RV yaw.
@@ -74,6 +78,7 @@ class NaivePdr {
           ns_to_s(s.t_ns - last_step_ns_) > kMinGapS && have_yaw_) {
         pos_en_ += kStepM * Eigen::Vector2d(std::sin(yaw_rad_), std::cos(yaw_rad_));
         last_step_ns_ = s.t_ns;
+        ++steps_;
       }
     }
     have_ = true;
@@ -85,8 +90,10 @@ class NaivePdr {
   }
   void start(const Eigen::Vector2d& en) { pos_en_ = en; }
   const Eigen::Vector2d& pos_en() const { return pos_en_; }
+  std::int64_t steps() const { return steps_; }
 
  private:
+  std::int64_t steps_ = 0;
   static constexpr double kCutHz = 3.0, kPeakAboveG = 1.0, kMinGapS = 0.3, kStepM = 0.70;
   bool have_ = false, have_yaw_ = false;
   TimeNs last_ns_ = 0, last_step_ns_ = 0;
@@ -101,6 +108,7 @@ struct WalkResult {
   std::int64_t steps = 0;
   double declination_deg = kNaN;
   std::int64_t qsf_tested = 0, qsf_static = 0;  // --via pdr: magnetometer readings, quasi-static ones
+  std::int64_t waving_steps = -1, naive_waving_steps = -1;  // --wave: steps out before the walk began
 };
 
 double median(std::vector<double> v) {
@@ -265,10 +273,80 @@ double segment_heading_error_deg(const Eigen::Vector2d& truth_en, const Eigen::V
   return wrap_pi(std::atan2(est_en.x(), est_en.y()) - std::atan2(truth_en.x(), truth_en.y())) / kDegToRad;
 }
 
+std::vector<Sample> read_samples(const std::string& path) {
+  io::LogReader reader(path);
+  std::vector<Sample> out;
+  Sample s;
+  while (reader.next(s)) out.push_back(s);
+  return out;
+}
+
+/// The walk as if the walker had first waved the phone for --wave seconds standing at the first
+/// waypoint (the issue's "as recorded" sessions, which start with calibration waving): the first
+/// Truth line moves to the start of the waving, the synthesised samples (phonesim/handling.h)
+/// end 20 ms before the first sensor sample, in its attitude and field. walk_start_ns: the
+/// original first waypoint time.
+std::vector<Sample> with_waving(const std::vector<Sample>& in, const EvalPdrArgs& a, const std::string& path,
+                                TimeNs* walk_start_ns) {
+  phonesim::WavingEnd end;
+  std::optional<std::size_t> truth0, first_sensor;
+  std::vector<Eigen::Vector3d> acc, rate;
+  std::int64_t utc_minus_ns_ms = kMissingInt;  // utc_ms - t_ns / 1e6 of the first accelerometer sample
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const Sample& s = in[i];
+    if (std::holds_alternative<TruthSample>(s) && !truth0) truth0 = i;
+    if (const auto* x = std::get_if<AccelSample>(&s)) {
+      if (!first_sensor) first_sensor = i, end.accel_phone_mps2 = x->acc_mps2;
+      if (x->utc_ms != kMissingInt && utc_minus_ns_ms == kMissingInt) utc_minus_ns_ms = x->utc_ms - x->t_ns / 1'000'000;
+      if (acc.size() < 110) acc.push_back(x->acc_mps2);
+    } else if (const auto* x = std::get_if<GyroSample>(&s)) {
+      if (rate.size() < 110) rate.push_back(x->rate_radps);
+    } else if (const auto* x = std::get_if<RotationVectorSample>(&s)) {
+      if (!end.phone_to_enu) end.phone_to_enu = Eigen::Quaterniond(x->quat_xyzw.w(), x->quat_xyzw.x(), x->quat_xyzw.y(), x->quat_xyzw.z());
+    } else if (const auto* x = std::get_if<MagSample>(&s)) {
+      if (!end.field_phone_ut) end.field_phone_ut = x->field_ut;
+    }
+  }
+  if (!truth0 || !first_sensor) throw std::runtime_error(path + ": --wave needs a Truth line and accelerometer samples");
+  end.t_end_ns = sample_time_ns(in[*first_sensor]) - 20'000'000;
+  end.accel_noise_mps2 = phonesim::running_mean_residuals(acc);
+  end.gyro_noise_radps = phonesim::running_mean_residuals(rate);
+  phonesim::WavingOptions opt;
+  opt.seconds = a.wave_s;
+  opt.seed = a.wave_seed;
+  opt.amplitude = a.wave_amplitude;
+  const phonesim::WavingSamples w = phonesim::synthesize_waving(end, opt);
+  *walk_start_ns = std::get<TruthSample>(in[*truth0]).t_ns;
+  auto utc = [&](TimeNs t) { return utc_minus_ns_ms == kMissingInt ? kMissingInt : utc_minus_ns_ms + t / 1'000'000; };
+  std::vector<Sample> out;
+  for (std::size_t i = 0; i < *first_sensor; ++i)
+    if (i != *truth0) out.push_back(in[i]);  // Meta lines
+  TruthSample start = std::get<TruthSample>(in[*truth0]);
+  start.t_ns = w.accel.empty() ? start.t_ns : std::min(start.t_ns, w.accel.front().t_ns);
+  out.push_back(start);
+  for (std::size_t k = 0; k < w.accel.size(); ++k) {  // per instant as the ILC logs: Accel, Mag, Gyro, RV
+    AccelSample x = w.accel[k];
+    x.utc_ms = utc(x.t_ns);
+    out.push_back(x);
+    if (k < w.mag.size()) out.push_back(MagSample{w.mag[k].t_ns, utc(w.mag[k].t_ns), w.mag[k].field_ut});
+    out.push_back(GyroSample{w.gyro[k].t_ns, utc(w.gyro[k].t_ns), w.gyro[k].rate_radps});
+    if (k < w.rotation.size()) {
+      RotationVectorSample r = w.rotation[k];
+      r.utc_ms = utc(r.t_ns);
+      out.push_back(r);
+    }
+  }
+  for (std::size_t i = *first_sensor; i < in.size(); ++i)
+    if (i != *truth0) out.push_back(in[i]);
+  return out;
+}
+
 WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   WalkResult r;
   r.name = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
-  io::LogReader reader(path);
+  std::vector<Sample> samples = read_samples(path);
+  TimeNs walk_start_ns = std::numeric_limits<TimeNs>::min();
+  if (a.wave_s > 0.0) samples = with_waving(samples, a, path, &walk_start_ns);
   Runner run(a);
   NaivePdr naive;
   geo::LocalFrame frame;
@@ -278,8 +356,11 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   std::vector<Eigen::Vector2d> truth_en, est_en, naive_en;
   double naive_path_m = 0;
   Eigen::Vector2d naive_last = Eigen::Vector2d::Zero();
-  Sample s;
-  while (reader.next(s)) {
+  for (const Sample& s : samples) {
+    if (a.wave_s > 0.0 && r.waving_steps < 0 && sample_time_ns(s) >= walk_start_ns && !std::holds_alternative<MetaSample>(s)) {
+      r.waving_steps = run.steps();
+      r.naive_waving_steps = naive.steps();
+    }
     if (const auto* m = std::get_if<AccelSample>(&s); m && first_utc == kMissingInt && m->utc_ms != kMissingInt)
       first_utc = m->utc_ms;
     if (const auto* t = std::get_if<TruthSample>(&s)) {
@@ -370,6 +451,9 @@ int run_eval_pdr(const EvalPdrArgs& a) {
                 r.name.c_str(), r.errors_m.size() + 1, static_cast<long long>(r.steps), r.mean_m,
                 *std::max_element(r.errors_m.begin(), r.errors_m.end()), r.length_ratio,
                 median(r.seg_heading_err_deg), r.naive_mean_m, r.naive_ratio);
+    if (a.wave_s > 0.0)
+      std::printf("    waving_steps: %lld (naive %lld)\n", static_cast<long long>(r.waving_steps),
+                  static_cast<long long>(r.naive_waving_steps));
     if (!a.quiet) {
       std::printf("    waypoint_errors_m: %s\n", join(r.errors_m, 2).c_str());
       std::printf("    segment_heading_error_deg: %s\n", join(r.seg_heading_err_deg, 1).c_str());
@@ -399,6 +483,18 @@ int run_eval_pdr(const EvalPdrArgs& a) {
   if (qsf_tested > 0)
     std::printf("quasi-static field: %lld of %lld magnetometer readings (%.1f %%)\n", static_cast<long long>(qsf_static),
                 static_cast<long long>(qsf_tested), 100.0 * static_cast<double>(qsf_static) / static_cast<double>(qsf_tested));
+  if (a.wave_s > 0.0) {
+    std::vector<double> ws, nws;
+    int over = 0;
+    for (const auto& r : all) {
+      ws.push_back(static_cast<double>(r.waving_steps));
+      nws.push_back(static_cast<double>(r.naive_waving_steps));
+      over += r.waving_steps > 2;
+    }
+    std::printf("waving (%.0f s, seed %llu, amplitude %.2f): steps out before the walk: median %.0f, max %.0f, walks with > 2: %d of %zu (naive: median %.0f)\n",
+                a.wave_s, static_cast<unsigned long long>(a.wave_seed), a.wave_amplitude, median(ws),
+                percentile(ws, 100), over, all.size(), median(nws));
+  }
   std::printf("per-walk mean error: p25 %.2f m, p75 %.2f m, max %.2f m\n", percentile(means, 25), percentile(means, 75),
               percentile(means, 100));
   std::printf("median_mean_error_m: %.2f median_length_ratio: %.3f\n", median(means), median(ratios));
@@ -429,6 +525,14 @@ void register_eval_pdr(CLI::App& app) {
   c->add_option("--qsf-field-std", a->qsf_field_std_ut, "with --via pdr: QSF |B| std threshold, uT");
   c->add_option("--qsf-window", a->qsf_window_s, "with --via pdr: QSF window, s");
   c->add_flag("--compass-only", a->compass_only, "with --via pdr: ignore the rotation vector (raw compass heading)");
+  c->add_option("--wave", a->wave_s,
+                 "seconds of synthesised compass-calibration waving at the first waypoint before the walk "
+                 "(phonesim/handling.h; the track starts with it)")
+      ->check(CLI::Range(0.0, 600.0));
+  c->add_option("--wave-seed", a->wave_seed, "seed of the waving")->capture_default_str();
+  c->add_option("--wave-amplitude", a->wave_amplitude, "scale of the waving's rotation and translation")
+      ->check(CLI::Range(0.0, 3.0))
+      ->capture_default_str();
   c->add_flag("--quiet", a->quiet, "one line per walk");
   c->add_flag("--legacy", a->legacy,
               "the engine as before issue 16 (chest mount, latest rotation vector, APT 1.75 m, no motion gate)");

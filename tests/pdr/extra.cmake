@@ -64,3 +64,13 @@ add_test(NAME pdr_cli_eval_pdr
 # all three walks within 6 m mean error (they are 2.4-5 m today; the legacy engine: > 10 m)
 set_tests_properties(pdr_cli_eval_pdr PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_ilc
                      PASS_REGULAR_EXPRESSION "walks 3 \\(failed 0\\).*median_mean_error_m: [0-5]\\.[0-9]+ median_length_ratio: [01]\\.[0-9]+\n")
+# The same walks "as recorded": 30 s of synthesised compass-calibration waving at the first
+# waypoint before each (phonesim/handling.h): no walk may get more than 2 steps from it, and the
+# track must stay usable (the naive PDR counts ~46 steps in it and is ~20 m off).
+add_test(NAME pdr_cli_eval_pdr_waving
+         COMMAND pdnav eval-pdr --quiet --wave 30 --wave-seed 2
+                 "${_pdr_ilc_out}/site2_F3_5dd38fff44333f00067aa387.log"
+                 "${_pdr_ilc_out}/site2_F3_5dd398c544333f00067aa431.log"
+                 "${_pdr_ilc_out}/site1_F4_5ddb656fc5b77e0006b1792e.log")
+set_tests_properties(pdr_cli_eval_pdr_waving PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_ilc
+                     PASS_REGULAR_EXPRESSION "walks with > 2: 0 of 3 .*median_mean_error_m: [0-5]\\.[0-9]+ ")

@@ -18,6 +18,7 @@
 #include "pdnav/pdr/motion_classifier.h"
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/pdr/placement.h"
+#include "pdnav/phonesim/handling.h"
 #include "real_walk.h"
 #include "test_data.h"
 
@@ -31,54 +32,31 @@ namespace {
 
 const char* kWalk = "pdr-ilc2020/data/site2/F3/path_data_files/5dd38fff44333f00067aa387.txt";
 
-/// 30 s of compass-calibration waving: figure-eight wrist rotations (1:2 frequency ratio about
-/// two axes, a third slower one) at 0.6-1.2 Hz with a seeded drifting rate, amplitudes
-/// 35-70 deg (times `amplitude`), and hand translation of 1.5-3 m/s^2 (times `amplitude`), ending in the attitude the walk starts with.
-/// The sensor noise is the real walk's own: the residual of its first samples around their
-/// 0.2 s mean is added to every synthetic sample.
+/// 30 s of compass-calibration waving (phonesim/handling.h) ending at t_end_ns in the real
+/// walk's first attitude, with the walk's own sensor noise.
 RealWalk make_waving(const RealWalk& real, TimeNs t_end_ns, double seconds, std::uint64_t seed, double amplitude) {
-  RealWalk w;
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> n01(0.0, 1.0);
-  const double rate_hz = 50.0, dt = 1.0 / rate_hz;
-  const int n = static_cast<int>(seconds * rate_hz);
-  // real noise: residuals of the first 100 samples around a 10-sample running mean
-  std::vector<Eigen::Vector3d> acc_noise, gyro_noise;
-  for (std::size_t i = 5; i + 5 < std::min<std::size_t>(real.accel.size(), 105); ++i) {
-    Eigen::Vector3d ma = Eigen::Vector3d::Zero(), mg = Eigen::Vector3d::Zero();
-    for (std::size_t k = i - 5; k < i + 5; ++k) ma += real.accel[k].acc_mps2, mg += real.gyro[k].rate_radps;
-    acc_noise.push_back(real.accel[i].acc_mps2 - ma / 10.0);
-    gyro_noise.push_back(real.gyro[i].rate_radps - mg / 10.0);
+  phonesim::WavingEnd end;
+  end.t_end_ns = t_end_ns;
+  end.accel_phone_mps2 = real.accel.front().acc_mps2;
+  if (!real.rotation.empty()) {
+    const Eigen::Vector4d& q = real.rotation.front().quat_xyzw;
+    end.phone_to_enu = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z());
   }
-  const Eigen::Vector3d g0 = real.accel.front().acc_mps2;  // the walk's first attitude (gravity)
-  const Eigen::Quaterniond q0 = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), g0.normalized());
-  double phase = 0.0, f_hz = 0.9;
-  auto attitude = [&](double ph, double fade) {
-    return q0 * Eigen::AngleAxisd(fade * 70 * kDegToRad * std::sin(ph), Eigen::Vector3d::UnitZ()) *
-           Eigen::AngleAxisd(fade * 55 * kDegToRad * std::sin(2 * ph + 0.6), Eigen::Vector3d::UnitX()) *
-           Eigen::AngleAxisd(fade * 35 * kDegToRad * std::sin(0.5 * ph + 1.1), Eigen::Vector3d::UnitY());
-  };
-  Eigen::Quaterniond prev = attitude(0.0, 0.0);
-  for (int i = 0; i < n; ++i) {
-    const double t = i * dt;
-    f_hz = std::clamp(f_hz + 0.05 * n01(rng), 0.6, 1.2);
-    phase += 2 * kPi * f_hz * dt;
-    const double fade = amplitude * std::min({1.0, t / 1.0, (seconds - t) / 1.0});  // 1 s in, 1 s out
-    const Eigen::Quaterniond q = attitude(phase, std::max(0.0, fade));
-    const Eigen::AngleAxisd rel(prev.conjugate() * q);
-    prev = q;
-    Eigen::Vector3d rate = rel.angle() < 1e-12 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(rel.axis() * rel.angle() / dt);
-    // hand translation in the world (phone-start frame), 1.5-3 m/s^2
-    const Eigen::Vector3d lin_world(2.5 * std::sin(phase + 0.3), 1.5 * std::sin(2 * phase), 3.0 * std::sin(phase * 1.5 + 2.0));
-    // specific force in phone axes: q maps phone -> start frame whose z is the walk's gravity
-    Eigen::Vector3d f = q.conjugate() * (Eigen::Vector3d(0, 0, g0.norm()) + std::max(0.0, fade) * lin_world);
-    f += acc_noise[i % acc_noise.size()];
-    rate += gyro_noise[i % gyro_noise.size()];
-    const TimeNs t_ns = t_end_ns - static_cast<TimeNs>((n - i) * dt * 1e9);
-    w.accel.push_back({t_ns, kMissingInt, f});
-    w.gyro.push_back({t_ns, kMissingInt, rate});
-  }
-  return w;
+  std::vector<Eigen::Vector3d> acc, rate;
+  for (const auto& a : real.accel) acc.push_back(a.acc_mps2);
+  for (const auto& g : real.gyro) rate.push_back(g.rate_radps);
+  end.accel_noise_mps2 = phonesim::running_mean_residuals(acc);
+  end.gyro_noise_radps = phonesim::running_mean_residuals(rate);
+  phonesim::WavingOptions opt;
+  opt.seconds = seconds;
+  opt.seed = seed;
+  opt.amplitude = amplitude;
+  phonesim::WavingSamples w = phonesim::synthesize_waving(end, opt);
+  RealWalk out;
+  out.accel = std::move(w.accel);
+  out.gyro = std::move(w.gyro);
+  out.rotation = std::move(w.rotation);
+  return out;
 }
 
 }  // namespace

@@ -91,7 +91,10 @@ void PlacementEstimator::feed(const AccelSample& s, bool walking) {
     moved_since_ns_ = -1;
   }
   // vertical and horizontal linear acceleration; horizontal kept for the lagged product
-  const Eigen::Vector3d lin = s.acc_mps2 - mean;
+  // linear acceleration, high-passed so that only the gait (>= ~1 Hz) enters the phase
+  // correlation: a phone being tilted or lowered leaves a slow ramp in (a - 2 s mean) that
+  // correlates with itself at any lag
+  const Eigen::Vector3d lin = gait_band(s.acc_mps2 - mean, dt);
   const double av = lin.dot(up_);
   const Eigen::Vector3d h = lin - av * up_;
   hist_.emplace_back(s.t_ns, h);
@@ -106,6 +109,19 @@ void PlacementEstimator::feed(const AccelSample& s, bool walking) {
     walking_s_ += dt;
     update_forward();
   }
+}
+
+Eigen::Vector3d PlacementEstimator::gait_band(const Eigen::Vector3d& lin, double dt_s) {
+  if (!(opt_.gait_highpass_hz > 0.0)) return lin;
+  if (!(dt_s > 0.0) || dt_s > 0.5) {  // first sample or after a gap: the filter restarts
+    hp_in_ = lin;
+    hp_out_.setZero();
+    return hp_out_;
+  }
+  const double a = 1.0 / (1.0 + 2.0 * kPi * opt_.gait_highpass_hz * dt_s);  // first-order high-pass
+  hp_out_ = a * (hp_out_ + lin - hp_in_);
+  hp_in_ = lin;
+  return hp_out_;
 }
 
 void PlacementEstimator::update_forward() {

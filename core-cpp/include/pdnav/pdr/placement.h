@@ -38,6 +38,7 @@ struct PlacementOptions {
   double change_angle_rad = 40 * kDegToRad;  // gravity moved this far in phone axes ...
   double change_hold_s = 1.5;          // ... for this long: a new placement bout
   double phase_lag_s = 0.14;           // a quarter of a 0.55 s step (1.8 Hz cadence)
+  double gait_highpass_hz = 0.6;       // first-order high-pass of the linear acceleration (0 = off)
   double flip_corr = -0.25;            // flat/upright prior reversed only below this correlation
   double min_bout_s = 2.0;             // correlation trusted after this much walking in a bout
   // Steps taken before that (the first steps of a bout) are held by Pdr at most this long for
@@ -93,6 +94,7 @@ class PlacementEstimator {
  private:
   void start_bout(TimeNs t_ns);
   void update_forward();
+  Eigen::Vector3d gait_band(const Eigen::Vector3d& lin, double dt_s);
 
   PlacementOptions opt_;
   std::deque<std::pair<TimeNs, Eigen::Vector3d>> win_;
@@ -112,6 +114,7 @@ class PlacementEstimator {
   // lagged correlation: vertical now x horizontal tau ago (phone axes)
   std::deque<std::pair<TimeNs, Eigen::Vector3d>> hist_;  // (t, horizontal linear acceleration)
   Eigen::Vector3d corr_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hp_in_ = Eigen::Vector3d::Zero(), hp_out_ = Eigen::Vector3d::Zero();
   double var_v_ = 0.0, n_corr_ = 0.0;
   Eigen::Matrix3d cov_h_ = Eigen::Matrix3d::Zero();
   double walking_s_ = 0.0;
