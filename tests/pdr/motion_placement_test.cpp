@@ -89,6 +89,56 @@ TEST(PdrMotion, ThirtySecondsOfWavingBeforeARealWalkCountNoSteps) {
   }
 }
 
+TEST(PdrMotion, StepsRightAfterWavingKeepTheWalksHeading) {
+  // After 30 s of waving the walk's steps must head where the same walk's steps head without
+  // it: the offset learned while the phone was waved is discarded when the handling begins
+  // (the gyro yaw was integrated about an unknown gravity then), and the first placement bout
+  // after it keeps what was learned since (it used to restart the offset when it opened: a step
+  // taken at that instant had no absolute heading and went 196 deg off on walk 5dd39040).
+  PdrOptions o;
+  o.heading.mount = Mount::kAuto;
+  for (const char* id : {"5dd3904027889b0006b76afc", "5dd38fff44333f00067aa387", "5dd398dc44333f00067aa447"}) {
+    const RealWalk walk = read_ilc(pdnav::test::shared_data(std::string("pdr-ilc2020/data/site2/F3/path_data_files/") + id + ".txt"));
+    ASSERT_GT(walk.accel.size(), 300u) << id;
+    const TimeNs start = walk.accel.front().t_ns;
+    const auto alone = run(o, walk);
+    const auto after = run(o, make_waving(walk, start - 20'000'000, 30.0, 1, 1.0), &walk);
+    double worst_deg = 0;
+    std::size_t matched = 0;
+    for (const auto& s : after) {
+      if (s.t_ns < start) continue;
+      for (const auto& a : alone) {
+        if (std::abs(ns_to_s(a.t_ns - s.t_ns)) > 0.03) continue;
+        worst_deg = std::max(worst_deg, std::abs(rad_to_deg(wrap_pi(s.heading_rad - a.heading_rad))));
+        ++matched;
+      }
+    }
+    std::printf("%s: %zu of %zu steps after the waving matched, worst heading difference %.1f deg\n", id, matched,
+                alone.size(), worst_deg);
+    EXPECT_GE(matched + 5, alone.size()) << id;  // at most the first few steps fall in the waving's hang-over
+    EXPECT_LT(worst_deg, 25.0) << id;
+  }
+}
+
+TEST(PdrHeadingFusion, TheFirstPlacementBoutKeepsTheOffsetLearnedBeforeIt) {
+  // The placement estimator opens its first bout once it has 1 s of gravity; the heading offset
+  // learned from the rotation vector until then refers to the same axis (+Y) and must survive:
+  // restarting it left the next step without an absolute heading (sigma pi).
+  const RealWalk walk = read_ilc(pdnav::test::shared_data(kWalk));
+  PdrOptions o;
+  o.heading.mount = Mount::kAuto;
+  Pdr p(o);
+  std::size_t ig = 0, ir = 0, unreferenced = 0;
+  for (const auto& s : walk.accel) {
+    while (ig < walk.gyro.size() && walk.gyro[ig].t_ns <= s.t_ns) p.feed(walk.gyro[ig++]);
+    while (ir < walk.rotation.size() && walk.rotation[ir].t_ns <= s.t_ns) p.feed(walk.rotation[ir++]);
+    p.feed(s);
+    if (ir > 0 && p.heading_sigma_rad() > 1.0) ++unreferenced;  // > 57 deg: no absolute heading
+  }
+  ASSERT_GT(p.placements().size(), 0u);
+  EXPECT_EQ(unreferenced, 0u);
+}
+
 TEST(PdrMotion, WalkingWithASwingingHandIsNotHandling) {
   // one-axis rotation (arm swing, +-40 deg at 0.9 Hz): high rate, low axis spread
   MotionClassifier c;

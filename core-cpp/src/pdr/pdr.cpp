@@ -18,7 +18,8 @@ Pdr::Pdr(const PdrOptions& options)
       classifier_(options.motion),
       placement_(options.placement),
       fusion_(options.fusion),
-      qsf_(options.fusion) {}
+      qsf_(options.fusion),
+      fusion_reference_(placement_.reference_phone()) {}  // readings before the first bout use it
 
 void Pdr::set_location(const geo::Geodetic& where, std::int64_t utc_ms) {
   const geo::Declination d = geo::declination_at(where, utc_ms);
@@ -42,12 +43,25 @@ Eigen::Vector3d Pdr::reference_axis() const {
 void Pdr::sync_placement() {
   if (placement_.revision() == placement_revision_) return;
   placement_revision_ = placement_.revision();
-  // a new placement bout: the reference axis may have changed, restart the offset (auto only)
-  if (opt_.heading.mount == Mount::kAuto) fusion_.reset();
-  qsf_.reset();  // the offset refers to the reference axis
+  // A new placement bout: the offset refers to the reference axis, so it restarts when the axis
+  // changed (auto only). About the same axis it is kept: a handling span in between already
+  // restarted it (absolute_heading), and a re-grip does not move the gyro frame.
+  if (opt_.heading.mount == Mount::kAuto && placement_.reference_phone() != fusion_reference_) {
+    fusion_.reset();
+    qsf_.reset();  // the offset refers to the reference axis
+  }
+  fusion_reference_ = placement_.reference_phone();
 }
 
 void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight) {
+  // While the phone is handled (waved, turned over) the gyro yaw is integrated about a gravity
+  // that is not known: the offset learned then would be wrong afterwards. It restarts when the
+  // handling begins and learns again from the first reading after it.
+  if (opt_.gate_handling && classifier_.state() == MotionState::kHandling) {
+    if (!handling_reset_) fusion_.reset(), qsf_.reset(), handling_reset_ = true;
+    return;
+  }
+  handling_reset_ = false;
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s &&
                          tracker_.has_gravity();
   fusion_.add(t_ns, heading_mag_rad, tracker_.yaw_rad(), weight, gyro_live);
