@@ -71,6 +71,11 @@ void MotionClassifier::update(TimeNs t_ns) {
                          gyro_.size() >= 4;
   handling_raw_ = gyro_live && ((rate_rms_ > opt_.handling_rate_radps && spread_ > opt_.axis_spread_min) ||
                                 rate_rms_ > opt_.extreme_rate_radps);
+  const double f = opt_.suspect_fraction;
+  suspect_ = gyro_live && ((rate_rms_ > f * opt_.handling_rate_radps && spread_ > opt_.axis_spread_min) ||
+                           rate_rms_ > f * opt_.extreme_rate_radps);
+  // a session's first second (or after a gyro gap): no full window of evidence either way
+  young_ = !gyro_.empty() && ns_to_s(gyro_.back().first - gyro_.front().first) < 0.8 * opt_.window_s;
   if (handling_raw_) handling_last_ns_ = t_ns;
   const bool handling = handling_last_ns_ >= 0 && ns_to_s(t_ns - handling_last_ns_) <= opt_.hold_s;
   if (handling) {

@@ -78,6 +78,7 @@ void Pdr::feed(const AccelSample& s) {
   else placement_.feed(s, gate_.in_bout() || gate_.pending() > 0);  // first steps teach it too
   sync_placement();
   flush_undecided(s.t_ns, false);
+  settle_handling_wait(s.t_ns, false);
   settle_vehicle_wait(s.t_ns, false);
   // two steps between pauses count as a walk only while the handling gate can refuse jolts
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(s.t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
@@ -136,6 +137,43 @@ Pdr::HeldStep Pdr::reprojected(HeldStep h) const {
 }
 
 void Pdr::deliver(HeldStep h, TimeNs now_ns) {
+  if (opt_.gate_handling && (classifier_.handling_suspect() || classifier_.evidence_young() || !handling_wait_.empty())) {
+    h.handling_suspect = classifier_.handling_suspect() || classifier_.evidence_young();
+    handling_wait_.push_back(h);
+    return;
+  }
+  deliver_after_handling(h, now_ns);
+}
+
+void Pdr::settle_handling_wait(TimeNs now_ns, bool force) {
+  if (handling_wait_.empty()) return;
+  // handling followed the suspicion: the waiting steps were its onset
+  if (classifier_.state() == MotionState::kHandling) {
+    counters_.steps_discarded_by_motion += static_cast<std::int64_t>(handling_wait_.size());
+    handling_wait_.clear();
+    return;
+  }
+  const TimeNs window_ns = s_to_ns(opt_.motion.window_s), max_ns = 3 * window_ns;
+  while (!handling_wait_.empty()) {
+    const HeldStep& h = handling_wait_.front();
+    if (classifier_.handling_at(h.candidate.t_ns)) {
+      ++counters_.steps_discarded_by_motion;
+      handling_wait_.pop_front();
+      continue;
+    }
+    const TimeNs age = now_ns - h.candidate.t_ns;
+    // a full window of evidence, one window after a step taken under suspicion, and the
+    // suspicion gone (at most three windows)
+    const bool wait = classifier_.evidence_young() || (h.handling_suspect && age < window_ns) ||
+                      (classifier_.handling_suspect() && age < max_ns);
+    if (!force && wait) return;
+    const HeldStep out = h;
+    handling_wait_.pop_front();
+    deliver_after_handling(out, now_ns);
+  }
+}
+
+void Pdr::deliver_after_handling(HeldStep h, TimeNs now_ns) {
   if (vehicle_gated()) {
     vehicle_wait_.push_back(h);
     return;
@@ -201,6 +239,7 @@ void Pdr::release(const std::vector<HeldStep>& steps, TimeNs now_ns) {
 
 void Pdr::finish() {
   release(gate_.finish(), latest_ns_);
+  settle_handling_wait(latest_ns_, true);
   settle_vehicle_wait(latest_ns_, true);
   flush_undecided(latest_ns_, true);
 }

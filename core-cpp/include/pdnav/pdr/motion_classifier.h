@@ -44,6 +44,12 @@ struct MotionClassifierOptions {
   double axis_spread_min = 0.25;
   double extreme_rate_radps = 6.0;
   double hold_s = 1.0;                // handling lasts this long after the features drop
+  // Suspicion: the same tests at this fraction of the rates. A step taken while the phone turns
+  // this much, or in a session's first window (no evidence yet), waits one window and while the
+  // suspicion lasts (at most three windows); handling that begins meanwhile refuses it. Waving
+  // that starts gently (the first second of a figure eight, one dominant axis) otherwise leaks
+  // the steps the bout gate releases at the second step (docs/pdr.md "Waving that starts gently").
+  double suspect_fraction = 0.6;
   double gyro_timeout_s = 0.5;        // no gyro sample for this long: no handling evidence
   // Vehicle (docs/pdr.md, "Vehicle class"). One evaluation every vehicle_eval_s over the last
   // vehicle_window_s of |a| averaged into vehicle_bin_s bins (20 Hz: keeps the gait band).
@@ -105,6 +111,10 @@ class MotionClassifier {
   bool handling_at(TimeNs t_ns) const;
   /// Handling spans so far (bounded to the last 256).
   const std::deque<MotionSpan>& handling_spans() const { return spans_; }
+  /// The rotation looks like the start or end of handling (MotionClassifierOptions::suspect_fraction).
+  bool handling_suspect() const { return suspect_; }
+  /// The gyro window is not full yet (the first second of a session): no handling evidence.
+  bool evidence_young() const { return young_; }
   double rate_rms_radps() const { return rate_rms_; }
   double axis_spread() const { return spread_; }
 
@@ -129,6 +139,7 @@ class MotionClassifier {
   double rate_rms_ = 0.0, spread_ = 0.0;
   MotionState state_ = MotionState::kStanding;
   bool handling_raw_ = false;
+  bool suspect_ = false, young_ = false;
   TimeNs handling_last_ns_ = -1;
   std::deque<MotionSpan> spans_;
   bool span_open_ = false;

@@ -149,6 +149,7 @@ class Pdr {
     std::int64_t placement_revision = -1;  // placement bout it was taken in (or the next one)
     Eigen::Vector3d reference_phone = Eigen::Vector3d::Zero();  // axis its heading refers to
     bool android = false;  // an Android step-detector event (emitted directly, no placement wait)
+    bool handling_suspect = false;  // delivered while the rotation looked like handling starting
   };
   HeldStep hold(const StepCandidate& c) const;
   void release(const std::vector<HeldStep>& steps, TimeNs now_ns);
@@ -159,6 +160,10 @@ class Pdr {
   /// Steps held while vehicle evidence accumulates: dropped inside a vehicle span, delivered
   /// once the evidence is gone (or at the end of the input).
   void settle_vehicle_wait(TimeNs now_ns, bool force);
+  /// Steps held one classifier window while handling is suspected: dropped if a handling span
+  /// covers them by then, else delivered.
+  void settle_handling_wait(TimeNs now_ns, bool force);
+  void deliver_after_handling(HeldStep h, TimeNs now_ns);
   bool vehicle_gated() const {
     return opt_.gate_vehicle && (classifier_.in_vehicle() || classifier_.vehicle_suspect());
   }
@@ -177,6 +182,7 @@ class Pdr {
   GyroTurnTracker tracker_;
   MotionClassifier classifier_;
   std::deque<HeldStep> vehicle_wait_;
+  std::deque<HeldStep> handling_wait_;
   PlacementEstimator placement_;
   HeadingFusion fusion_;
   QuasiStaticField qsf_;
