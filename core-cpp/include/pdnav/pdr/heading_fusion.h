@@ -1,9 +1,9 @@
 // Gyro-dominant heading (issue 16): the gyro carries the heading between absolute readings;
 // the absolute heading (rotation vector, else tilt-compensated compass) only sets the offset
 // between the integrated gyro yaw and north, as a weighted circular mean over the last tau_s.
-// The offset is fitted as a straight line in time (weighted least squares with the same
-// forgetting), so a residual gyro bias about the vertical is estimated too (clamped to
-// max_drift_radps, shrunk toward 0 while the readings span less than drift_prior_s).
+// The offset is fitted as a straight line in time (weighted least squares), so a residual gyro
+// bias about the vertical is estimated too, with its own long memory and a prior that keeps a
+// field changing along the walk out of it (options below; clamped to max_drift_radps).
 // A magnetometer reading is trusted (weight 1) only when its field magnitude and dip agree
 // with the WMM at the location (Afzal, Renaudin, Lachapelle, "Assessment of indoor magnetic
 // field anomalies using multiple magnetometers", ION GNSS 2010, and their quasi-static field
