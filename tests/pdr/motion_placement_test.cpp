@@ -97,7 +97,11 @@ TEST(PdrMotion, StepsRightAfterWavingKeepTheWalksHeading) {
   // taken at that instant had no absolute heading and went 196 deg off on walk 5dd39040).
   PdrOptions o;
   o.heading.mount = Mount::kAuto;
-  for (const char* id : {"5dd3904027889b0006b76afc", "5dd38fff44333f00067aa387", "5dd398dc44333f00067aa447"}) {
+  // 5dd398c5: a walker whose first steps have a negative vertical-forward correlation (-0.29 at
+  // 2.5 s of walking): with the flip threshold of a settled correlation from the start, the
+  // first segment after the waving went backwards (PlacementOptions::flip_settle_s).
+  for (const char* id : {"5dd3904027889b0006b76afc", "5dd38fff44333f00067aa387", "5dd398dc44333f00067aa447",
+                         "5dd398c544333f00067aa431"}) {
     const RealWalk walk = read_ilc(pdnav::test::shared_data(std::string("pdr-ilc2020/data/site2/F3/path_data_files/") + id + ".txt"));
     ASSERT_GT(walk.accel.size(), 300u) << id;
     const TimeNs start = walk.accel.front().t_ns;

@@ -111,6 +111,13 @@ void PlacementEstimator::feed(const AccelSample& s, bool walking) {
   }
 }
 
+double PlacementEstimator::flip_threshold() const {
+  // the correlation of T seconds of gait scatters as 1/sqrt(T): a reversal of the prior needs
+  // flip_corr at flip_settle_s of walking, proportionally more before
+  const double t = std::max(walking_s_, 1e-3);
+  return opt_.flip_corr * std::max(1.0, std::sqrt(opt_.flip_settle_s / t));
+}
+
 Eigen::Vector3d PlacementEstimator::gait_band(const Eigen::Vector3d& lin, double dt_s) {
   if (!(opt_.gait_highpass_hz > 0.0)) return lin;
   if (!(dt_s > 0.0) || dt_s > 0.5) {  // first sample or after a gap: the filter restarts
@@ -134,7 +141,7 @@ void PlacementEstimator::update_forward() {
     prior_supported_ = var_v_ > 0.0 && vf > 0.0 && prior.dot(corr_) > 0.0;
     if (trusted && vf > 0.0) c = prior.dot(corr_) / std::sqrt(var_v_ * vf);
     bout_.phase_corr = c;
-    bout_.forward_phone = (trusted && c < opt_.flip_corr) ? Eigen::Vector3d(-prior) : prior;
+    bout_.forward_phone = (trusted && c < flip_threshold()) ? Eigen::Vector3d(-prior) : prior;
     return;
   }
   // other placements: the lagged correlation vector, horizontal part

@@ -40,6 +40,7 @@ struct PlacementOptions {
   double phase_lag_s = 0.14;           // a quarter of a 0.55 s step (1.8 Hz cadence)
   double gait_highpass_hz = 0.6;       // first-order high-pass of the linear acceleration (0 = off)
   double flip_corr = -0.25;            // flat/upright prior reversed only below this correlation
+  double flip_settle_s = 4.0;          // ... after this much walking; before, below flip_corr sqrt(settle / t)
   double min_bout_s = 2.0;             // correlation trusted after this much walking in a bout
   // Steps taken before that (the first steps of a bout) are held by Pdr at most this long for
   // the direction, then re-projected with it (docs/pdr.md "First steps"); 0 = no waiting.
@@ -95,6 +96,7 @@ class PlacementEstimator {
   void start_bout(TimeNs t_ns);
   void update_forward();
   Eigen::Vector3d gait_band(const Eigen::Vector3d& lin, double dt_s);
+  double flip_threshold() const;
 
   PlacementOptions opt_;
   std::deque<std::pair<TimeNs, Eigen::Vector3d>> win_;
