@@ -338,36 +338,40 @@ TEST(PdrPlacement, FirstStepsOfAReversedPhoneAreReprojectedOnceTheDirectionIsKno
   // toward the walker; tools/ilc2log --turn-phone does the same to whole logs). The walk is the
   // same, so the steps' headings must be too, from the first step on: the first steps are
   // held until the phase correlation has decided the walking direction, then re-projected.
-  const RealWalk walk = read_ilc(pdnav::test::shared_data(kWalk));
-  RealWalk turned = walk;
-  for (auto& s : turned.accel) s.acc_mps2.x() = -s.acc_mps2.x(), s.acc_mps2.y() = -s.acc_mps2.y();
-  for (auto& s : turned.gyro) s.rate_radps.x() = -s.rate_radps.x(), s.rate_radps.y() = -s.rate_radps.y();
-  for (auto& s : turned.rotation) {
-    const Eigen::Vector4d q = s.quat_xyzw;  // q * (0, 0, 1, 0)
-    s.quat_xyzw = Eigen::Vector4d(q[1], -q[0], q[3], -q[2]);
+  // 5dd398db's correlation is weak (-0.25 to -0.35 for its first seconds): its steps must wait
+  // for the settled evidence instead of going out along the prior (12.8 m mean error before).
+  for (const char* path : {kWalk, "pdr-ilc2020/data/site2/F3/path_data_files/5dd398db44333f00067aa445.txt"}) {
+    const RealWalk walk = read_ilc(pdnav::test::shared_data(path));
+    RealWalk turned = walk;
+    for (auto& s : turned.accel) s.acc_mps2.x() = -s.acc_mps2.x(), s.acc_mps2.y() = -s.acc_mps2.y();
+    for (auto& s : turned.gyro) s.rate_radps.x() = -s.rate_radps.x(), s.rate_radps.y() = -s.rate_radps.y();
+    for (auto& s : turned.rotation) {
+      const Eigen::Vector4d q = s.quat_xyzw;  // q * (0, 0, 1, 0)
+      s.quat_xyzw = Eigen::Vector4d(q[1], -q[0], q[3], -q[2]);
+    }
+    PdrOptions o;
+    o.heading.mount = Mount::kAuto;
+    PdrOptions no_wait = o;
+    no_wait.placement.max_direction_wait_s = 0.0;
+    const auto ref = run(o, walk), rev = run(o, turned), rev_no_wait = run(no_wait, turned);
+    ASSERT_GE(ref.size(), 8u) << path;
+    ASSERT_EQ(rev.size(), ref.size()) << path;
+    ASSERT_EQ(rev_no_wait.size(), ref.size()) << path;
+    double worst = 0.0, worst_no_wait = 0.0;
+    for (std::size_t i = 0; i < 6; ++i) {
+      worst = std::max(worst, std::abs(wrap_pi(rev[i].heading_rad - ref[i].heading_rad)));
+      worst_no_wait = std::max(worst_no_wait, std::abs(wrap_pi(rev_no_wait[i].heading_rad - ref[i].heading_rad)));
+    }
+    std::printf("%s: first 6 steps, reversed phone vs as held: worst %.1f deg (%.1f deg without the re-projection)\n",
+                path, worst / kDegToRad, worst_no_wait / kDegToRad);
+    EXPECT_LT(worst, 20 * kDegToRad) << path;
+    EXPECT_GT(worst_no_wait, 150 * kDegToRad) << path;  // the defect this guards against
+    // as held, the wait changes nothing but the release time: same headings
+    const auto ref_no_wait = run(no_wait, walk);
+    ASSERT_EQ(ref_no_wait.size(), ref.size()) << path;
+    for (std::size_t i = 0; i < ref.size(); ++i)
+      EXPECT_LT(std::abs(wrap_pi(ref_no_wait[i].heading_rad - ref[i].heading_rad)), 1e-9) << path << " " << i;
   }
-  PdrOptions o;
-  o.heading.mount = Mount::kAuto;
-  PdrOptions no_wait = o;
-  no_wait.placement.max_direction_wait_s = 0.0;
-  const auto ref = run(o, walk), rev = run(o, turned), rev_no_wait = run(no_wait, turned);
-  ASSERT_GE(ref.size(), 8u);
-  ASSERT_EQ(rev.size(), ref.size());
-  ASSERT_EQ(rev_no_wait.size(), ref.size());
-  double worst = 0.0, worst_no_wait = 0.0;
-  for (std::size_t i = 0; i < 6; ++i) {
-    worst = std::max(worst, std::abs(wrap_pi(rev[i].heading_rad - ref[i].heading_rad)));
-    worst_no_wait = std::max(worst_no_wait, std::abs(wrap_pi(rev_no_wait[i].heading_rad - ref[i].heading_rad)));
-  }
-  std::printf("first 6 steps, reversed phone vs as held: worst %.1f deg (%.1f deg without the re-projection)\n",
-              worst / kDegToRad, worst_no_wait / kDegToRad);
-  EXPECT_LT(worst, 20 * kDegToRad);
-  EXPECT_GT(worst_no_wait, 150 * kDegToRad);  // the defect this guards against
-  // as held, the wait changes nothing but the release time: same headings
-  const auto ref_no_wait = run(no_wait, walk);
-  ASSERT_EQ(ref_no_wait.size(), ref.size());
-  for (std::size_t i = 0; i < ref.size(); ++i)
-    EXPECT_LT(std::abs(wrap_pi(ref_no_wait[i].heading_rad - ref[i].heading_rad)), 1e-9) << i;
 }
 
 TEST(PdrHeading, UnreliableMagnetometerAccuracyKeepsADisturbedRotationVectorFromDraggingTheHeading) {

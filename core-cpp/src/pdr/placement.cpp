@@ -34,7 +34,7 @@ void PlacementEstimator::start_bout(TimeNs t_ns) {
   corr_.setZero();
   cov_h_.setZero();
   var_v_ = n_corr_ = walking_s_ = 0.0;
-  prior_supported_ = false;
+  prior_supported_ = reversed_ = false;
   // placement from the dominant gravity axis; the reference axis is the placement's prior
   // walking axis (flat: +Y, upright: -Z), else the most horizontal of +X, +Y, -Z
   const double ax = std::abs(up_.x()), ay = std::abs(up_.y()), az = std::abs(up_.z());
@@ -141,7 +141,8 @@ void PlacementEstimator::update_forward() {
     prior_supported_ = var_v_ > 0.0 && vf > 0.0 && prior.dot(corr_) > 0.0;
     if (trusted && vf > 0.0) c = prior.dot(corr_) / std::sqrt(var_v_ * vf);
     bout_.phase_corr = c;
-    bout_.forward_phone = (trusted && c < flip_threshold()) ? Eigen::Vector3d(-prior) : prior;
+    reversed_ = trusted && c < flip_threshold();
+    bout_.forward_phone = reversed_ ? Eigen::Vector3d(-prior) : prior;
     return;
   }
   // other placements: the lagged correlation vector, horizontal part

@@ -44,7 +44,7 @@ struct PlacementOptions {
   double min_bout_s = 2.0;             // correlation trusted after this much walking in a bout
   // Steps taken before that (the first steps of a bout) are held by Pdr at most this long for
   // the direction, then re-projected with it (docs/pdr.md "First steps"); 0 = no waiting.
-  double max_direction_wait_s = 3.0;
+  double max_direction_wait_s = 4.5;  // > flip_settle_s: a weak reversal is still waited for
   // ... but only while the motion contradicts the placement's prior axis: after this much
   // walking with a positive phase correlation along the prior, the prior stands (no wait).
   double prior_confirm_s = 0.5;
@@ -83,11 +83,14 @@ class PlacementEstimator {
   /// Clockwise angle (rad) from the horizontal projection of reference_phone() to that of
   /// forward_phone() under the current gravity; 0 when either is near vertical.
   double forward_offset_rad() const;
-  /// The walking direction of the current bout has been decided from the motion (enough
-  /// walking for the phase correlation), not just the placement's prior.
-  /// Or the bout has a prior axis (flat, upright) that the motion so far supports.
+  /// The walking direction of the current bout is decided: the motion supports the prior axis
+  /// (after prior_confirm_s), or it contradicts it and the prior has been reversed (after
+  /// min_bout_s) or the evidence has settled (flip_settle_s) without a reversal.
   bool direction_known() const {
-    return in_bout_ && (walking_s_ >= opt_.min_bout_s || (walking_s_ >= opt_.prior_confirm_s && prior_supported_));
+    if (!in_bout_) return false;
+    if (prior_supported_) return walking_s_ >= opt_.prior_confirm_s;
+    // the motion contradicts the prior: known once reversed, or once the evidence has settled
+    return walking_s_ >= opt_.flip_settle_s || (walking_s_ >= opt_.min_bout_s && reversed_);
   }
   /// Every bout so far (closed ones and the open one last).
   std::vector<PlacementBout> bouts() const;
@@ -117,6 +120,7 @@ class PlacementEstimator {
   std::deque<std::pair<TimeNs, Eigen::Vector3d>> hist_;  // (t, horizontal linear acceleration)
   Eigen::Vector3d corr_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d hp_in_ = Eigen::Vector3d::Zero(), hp_out_ = Eigen::Vector3d::Zero();
+  bool reversed_ = false;  // the bout's prior axis has been reversed
   double var_v_ = 0.0, n_corr_ = 0.0;
   Eigen::Matrix3d cov_h_ = Eigen::Matrix3d::Zero();
   double walking_s_ = 0.0;
