@@ -302,7 +302,7 @@ std::vector<Sample> with_waving(const std::vector<Sample>& in, const EvalPdrArgs
     } else if (const auto* x = std::get_if<GyroSample>(&s)) {
       if (rate.size() < 110) rate.push_back(x->rate_radps);
     } else if (const auto* x = std::get_if<RotationVectorSample>(&s)) {
-      if (!end.phone_to_enu) end.phone_to_enu = Eigen::Quaterniond(x->quat_xyzw.w(), x->quat_xyzw.x(), x->quat_xyzw.y(), x->quat_xyzw.z());
+      if (!end.rotation_xyzw) end.rotation_xyzw = x->quat_xyzw;
     } else if (const auto* x = std::get_if<MagSample>(&s)) {
       if (!end.field_phone_ut) end.field_phone_ut = x->field_ut;
     }
@@ -317,24 +317,21 @@ std::vector<Sample> with_waving(const std::vector<Sample>& in, const EvalPdrArgs
   opt.amplitude = a.wave_amplitude;
   const phonesim::WavingSamples w = phonesim::synthesize_waving(end, opt);
   *walk_start_ns = std::get<TruthSample>(in[*truth0]).t_ns;
-  auto utc = [&](TimeNs t) { return utc_minus_ns_ms == kMissingInt ? kMissingInt : utc_minus_ns_ms + t / 1'000'000; };
   std::vector<Sample> out;
+  const auto push_stamped = [&](auto x) {  // the walk's UTC clock, extended back over the waving
+    x.utc_ms = utc_minus_ns_ms == kMissingInt ? kMissingInt : utc_minus_ns_ms + x.t_ns / 1'000'000;
+    out.push_back(x);
+  };
   for (std::size_t i = 0; i < *first_sensor; ++i)
     if (i != *truth0) out.push_back(in[i]);  // Meta lines
   TruthSample start = std::get<TruthSample>(in[*truth0]);
   start.t_ns = w.accel.empty() ? start.t_ns : std::min(start.t_ns, w.accel.front().t_ns);
   out.push_back(start);
   for (std::size_t k = 0; k < w.accel.size(); ++k) {  // per instant as the ILC logs: Accel, Mag, Gyro, RV
-    AccelSample x = w.accel[k];
-    x.utc_ms = utc(x.t_ns);
-    out.push_back(x);
-    if (k < w.mag.size()) out.push_back(MagSample{w.mag[k].t_ns, utc(w.mag[k].t_ns), w.mag[k].field_ut});
-    out.push_back(GyroSample{w.gyro[k].t_ns, utc(w.gyro[k].t_ns), w.gyro[k].rate_radps});
-    if (k < w.rotation.size()) {
-      RotationVectorSample r = w.rotation[k];
-      r.utc_ms = utc(r.t_ns);
-      out.push_back(r);
-    }
+    push_stamped(w.accel[k]);
+    if (k < w.mag.size()) push_stamped(w.mag[k]);
+    push_stamped(w.gyro[k]);
+    if (k < w.rotation.size()) push_stamped(w.rotation[k]);
   }
   for (std::size_t i = *first_sensor; i < in.size(); ++i)
     if (i != *truth0) out.push_back(in[i]);

@@ -38,10 +38,7 @@ RealWalk make_waving(const RealWalk& real, TimeNs t_end_ns, double seconds, std:
   phonesim::WavingEnd end;
   end.t_end_ns = t_end_ns;
   end.accel_phone_mps2 = real.accel.front().acc_mps2;
-  if (!real.rotation.empty()) {
-    const Eigen::Vector4d& q = real.rotation.front().quat_xyzw;
-    end.phone_to_enu = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z());
-  }
+  if (!real.rotation.empty()) end.rotation_xyzw = real.rotation.front().quat_xyzw;
   std::vector<Eigen::Vector3d> acc, rate;
   for (const auto& a : real.accel) acc.push_back(a.acc_mps2);
   for (const auto& g : real.gyro) rate.push_back(g.rate_radps);

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "pdnav/geo/time.h"
+#include "pdnav/gnss/spp.h"  // clock_group
 
 namespace pdnav::gnss {
 namespace {
@@ -168,8 +169,6 @@ bool supported(Constellation c) {
          c == Constellation::kBeidou || c == Constellation::kQzss;
 }
 
-/// Receiver-clock group (QZSS is steered to GPS time and shares its clock, as in spp.h).
-Constellation dual_group(Constellation sys) { return sys == Constellation::kQzss ? Constellation::kGps : sys; }
 
 /// FrequencyMode::kBest: in a clock group with at least `min_sats` usable L5/E5a/B2a codes,
 /// every such satellite is measured on that band (code, Doppler, carrier); the others keep L1.
@@ -179,9 +178,9 @@ void use_best_band(std::vector<Measurement>& meas, std::vector<Measurement>& l5,
                    ExclusionCounts& excluded) {
   drop_duplicates(l5, excluded);
   std::map<Constellation, int> per_group;
-  for (const Measurement& s5 : l5) ++per_group[dual_group(s5.sat.sys)];
+  for (const Measurement& s5 : l5) ++per_group[clock_group(s5.sat.sys)];
   for (const Measurement& s5 : l5) {
-    if (per_group[dual_group(s5.sat.sys)] < min_sats) {
+    if (per_group[clock_group(s5.sat.sys)] < min_sats) {
       ++excluded["best: too few L5/E5a codes in the clock group (L1 kept)"];
       continue;
     }
@@ -227,7 +226,7 @@ void combine_dual_frequency(std::vector<Measurement>& meas, const MeasurementOpt
   for (std::size_t i = 0; i < meas.size(); ++i) {
     const Measurement& m = meas[i];
     if (!m.code_ok()) continue;
-    const Constellation g = dual_group(m.sat.sys);
+    const Constellation g = clock_group(m.sat.sys);
     code_sats[g].push_back(i);
     if (std::isfinite(m.pseudorange_l5_m) && std::isfinite(m.cn0_l5_dbhz)) dual_sats[g].push_back(i);
   }

@@ -69,11 +69,13 @@ void MotionClassifier::feed(const GyroSample& s) {
 void MotionClassifier::update(TimeNs t_ns) {
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.gyro_timeout_s &&
                          gyro_.size() >= 4;
-  handling_raw_ = gyro_live && ((rate_rms_ > opt_.handling_rate_radps && spread_ > opt_.axis_spread_min) ||
-                                rate_rms_ > opt_.extreme_rate_radps);
-  const double f = opt_.suspect_fraction;
-  suspect_ = gyro_live && ((rate_rms_ > f * opt_.handling_rate_radps && spread_ > opt_.axis_spread_min) ||
-                           rate_rms_ > f * opt_.extreme_rate_radps);
+  // the handling tests with the rates scaled by f (1: handling, suspect_fraction: suspicion)
+  const auto turns_like_handling = [&](double f) {
+    return gyro_live && ((rate_rms_ > f * opt_.handling_rate_radps && spread_ > opt_.axis_spread_min) ||
+                         rate_rms_ > f * opt_.extreme_rate_radps);
+  };
+  handling_raw_ = turns_like_handling(1.0);
+  suspect_ = turns_like_handling(opt_.suspect_fraction);
   // a session's first second (or after a gyro gap): no full window of evidence either way
   young_ = !gyro_.empty() && ns_to_s(gyro_.back().first - gyro_.front().first) < 0.8 * opt_.window_s;
   if (handling_raw_) handling_last_ns_ = t_ns;

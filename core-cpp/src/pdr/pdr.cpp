@@ -137,8 +137,9 @@ Pdr::HeldStep Pdr::reprojected(HeldStep h) const {
 }
 
 void Pdr::deliver(HeldStep h, TimeNs now_ns) {
-  if (opt_.gate_handling && (classifier_.handling_suspect() || classifier_.evidence_young() || !handling_wait_.empty())) {
-    h.handling_suspect = classifier_.handling_suspect() || classifier_.evidence_young();
+  const bool suspect = classifier_.handling_suspect() || classifier_.evidence_young();
+  if (opt_.gate_handling && (suspect || !handling_wait_.empty())) {
+    h.handling_suspect = suspect;
     handling_wait_.push_back(h);
     return;
   }

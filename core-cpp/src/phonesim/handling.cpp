@@ -31,7 +31,7 @@ Eigen::Quaterniond wrist(double ph, double fade) {
 
 /// Phone -> ENU attitude the waving ends in: the rotation vector, else gravity alone (yaw 0).
 Eigen::Quaterniond end_attitude(const WavingEnd& end) {
-  if (end.phone_to_enu) return end.phone_to_enu->normalized();
+  if (end.rotation_xyzw) return Eigen::Quaterniond(*end.rotation_xyzw).normalized();  // Eigen's coefficient order is x, y, z, w
   const Eigen::Vector3d up_phone = end.accel_phone_mps2.norm() > 0 ? end.accel_phone_mps2.normalized() : Eigen::Vector3d::UnitZ();
   return Eigen::Quaterniond::FromTwoVectors(up_phone, Eigen::Vector3d::UnitZ());
 }
@@ -69,7 +69,7 @@ WavingSamples synthesize_waving(const WavingEnd& end, const WavingOptions& optio
     const TimeNs t_ns = end.t_end_ns - static_cast<TimeNs>(std::llround((n - 1 - i) * dt * 1e9));
     out.accel.push_back({t_ns, kMissingInt, f});
     out.gyro.push_back({t_ns, kMissingInt, rate});
-    if (end.phone_to_enu) out.rotation.push_back({t_ns, kMissingInt, Eigen::Vector4d(q.x(), q.y(), q.z(), q.w()), kNaN});
+    if (end.rotation_xyzw) out.rotation.push_back({t_ns, kMissingInt, q.coeffs(), kNaN});
     if (end.field_phone_ut) out.mag.push_back({t_ns, kMissingInt, q.conjugate() * field_enu});
   }
   return out;

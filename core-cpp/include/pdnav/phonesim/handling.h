@@ -32,7 +32,7 @@ struct WavingOptions {
 struct WavingEnd {
   TimeNs t_end_ns = 0;                                // time of the last waving sample
   Eigen::Vector3d accel_phone_mps2 = Eigen::Vector3d(0, 0, 9.81);  // first accelerometer reading
-  std::optional<Eigen::Quaterniond> phone_to_enu;     // first rotation vector (else yaw 0)
+  std::optional<Eigen::Vector4d> rotation_xyzw;       // first rotation vector, phone -> ENU (else yaw 0)
   std::optional<Eigen::Vector3d> field_phone_ut;      // first magnetometer reading (else no Mag)
   std::vector<Eigen::Vector3d> accel_noise_mps2;      // cycled; empty = no noise
   std::vector<Eigen::Vector3d> gyro_noise_radps;
@@ -41,7 +41,7 @@ struct WavingEnd {
 struct WavingSamples {
   std::vector<AccelSample> accel;
   std::vector<GyroSample> gyro;
-  std::vector<RotationVectorSample> rotation;  // only with WavingEnd::phone_to_enu
+  std::vector<RotationVectorSample> rotation;  // only with WavingEnd::rotation_xyzw
   std::vector<MagSample> mag;                  // only with WavingEnd::field_phone_ut
 };
 
