@@ -330,6 +330,26 @@ TEST(PdrMotion, AndroidStepEventsWhileWavingAreRefused) {
   }
 }
 
+TEST(PdrPlacement, APhoneOnItsSideDecidesItsDirectionAfterMinBoutWalking) {
+  // The real walk with the phone on its side (gravity along +X: placement "other", no prior
+  // axis). Its walking direction is the lagged correlation vector, trusted after min_bout_s of
+  // walking; the wait for a settled reversal (flip_settle_s) is for prior axes only.
+  const RealWalk walk = read_ilc(pdnav::test::shared_data(kWalk));
+  PlacementOptions opt;
+  PlacementEstimator est(opt);
+  double known_after_s = -1;
+  for (const auto& s : walk.accel) {
+    AccelSample side = s;  // rotate the phone 90 deg about its Y axis: z -> x
+    side.acc_mps2 = Eigen::Vector3d(s.acc_mps2.z(), s.acc_mps2.y(), -s.acc_mps2.x());
+    est.feed(side, true);
+    if (known_after_s < 0 && est.direction_known()) known_after_s = ns_to_s(s.t_ns - walk.accel.front().t_ns);
+  }
+  ASSERT_EQ(est.placement(), Placement::kOther);
+  std::printf("phone on its side: direction known %.2f s into the walk\n", known_after_s);
+  EXPECT_GT(known_after_s, opt.min_bout_s);
+  EXPECT_LT(known_after_s, opt.flip_settle_s);
+}
+
 TEST(PdrPlacement, FirstStepsOfAReversedPhoneAreReprojectedOnceTheDirectionIsKnown) {
   // The real walk, and the same walk with the phone turned 180 deg about its z axis (top
   // toward the walker; tools/ilc2log --turn-phone does the same to whole logs). The walk is the

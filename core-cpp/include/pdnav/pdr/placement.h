@@ -83,11 +83,14 @@ class PlacementEstimator {
   /// Clockwise angle (rad) from the horizontal projection of reference_phone() to that of
   /// forward_phone() under the current gravity; 0 when either is near vertical.
   double forward_offset_rad() const;
-  /// The walking direction of the current bout is decided: the motion supports the prior axis
+  /// The walking direction of the current bout is decided: without a prior axis ("other"), after
+  /// min_bout_s of walking; with one, the motion supports it
   /// (after prior_confirm_s), or it contradicts it and the prior has been reversed (after
   /// min_bout_s) or the evidence has settled (flip_settle_s) without a reversal.
   bool direction_known() const {
     if (!in_bout_) return false;
+    // no prior axis (placement "other"): the direction is the correlation itself, trusted at min_bout_s
+    if (bout_.placement != Placement::kFlat && bout_.placement != Placement::kUpright) return walking_s_ >= opt_.min_bout_s;
     if (prior_supported_) return walking_s_ >= opt_.prior_confirm_s;
     // the motion contradicts the prior: known once reversed, or once the evidence has settled
     return walking_s_ >= opt_.flip_settle_s || (walking_s_ >= opt_.min_bout_s && reversed_);
