@@ -45,7 +45,7 @@ void Pdr::sync_placement() {
   placement_revision_ = placement_.revision();
   // A new placement bout: the offset refers to the reference axis, so it restarts when the axis
   // changed (auto only). About the same axis it is kept: a handling span in between already
-  // restarted it (absolute_heading), and a re-grip does not move the gyro frame.
+  // restarted it (track_handling), and a re-grip does not move the gyro frame.
   if (opt_.heading.mount == Mount::kAuto && placement_.reference_phone() != fusion_reference_) {
     fusion_.reset();
     qsf_.reset();  // the offset refers to the reference axis
@@ -54,14 +54,7 @@ void Pdr::sync_placement() {
 }
 
 void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight) {
-  // While the phone is handled (waved, turned over) the gyro yaw is integrated about a gravity
-  // that is not known: the offset learned then would be wrong afterwards. It restarts when the
-  // handling begins and learns again from the first reading after it.
-  if (opt_.gate_handling && classifier_.state() == MotionState::kHandling) {
-    if (!handling_reset_) fusion_.reset(), qsf_.reset(), handling_reset_ = true;
-    return;
-  }
-  handling_reset_ = false;
+  if (handling_reset_) return;  // handled: no offset is learned (track_handling)
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s &&
                          tracker_.has_gravity();
   fusion_.add(t_ns, heading_mag_rad, tracker_.yaw_rad(), weight, gyro_live);
@@ -69,9 +62,19 @@ void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight) {
   ref_t_ns_ = t_ns;
 }
 
+void Pdr::track_handling() {
+  // While the phone is handled (waved, turned over) the gyro yaw is integrated about a gravity
+  // that is not known: the offset learned then would be wrong afterwards. It restarts when the
+  // handling begins and learns again from the first absolute reading after it.
+  const bool handled = opt_.gate_handling && classifier_.state() == MotionState::kHandling;
+  if (handled && !handling_reset_) fusion_.reset(), qsf_.reset();
+  handling_reset_ = handled;
+}
+
 void Pdr::feed(const AccelSample& s) {
   tracker_.feed(s);
   classifier_.feed(s);
+  track_handling();
   const bool handling = opt_.gate_handling && classifier_.state() == MotionState::kHandling;
   const bool riding = opt_.gate_vehicle && classifier_.in_vehicle();
   if (handling || riding) placement_.end_bout();  // the phone is being moved: re-estimate afterwards
@@ -248,6 +251,7 @@ void Pdr::finish() {
 void Pdr::feed(const GyroSample& s) {
   tracker_.feed(s);
   classifier_.feed(s);
+  track_handling();
   if (s.rate_radps.allFinite() && s.t_ns >= last_gyro_ns_) last_gyro_ns_ = s.t_ns;
   latest_ns_ = std::max(latest_ns_, s.t_ns);
 }

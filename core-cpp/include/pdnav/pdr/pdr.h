@@ -189,7 +189,8 @@ class Pdr {
   Eigen::Vector3d fusion_reference_;  // the reference axis fusion_'s offset refers to
   double qsf_weight() const { return qsf_.quasi_static() ? 1.0 : opt_.fusion.non_qsf_weight; }
   std::int64_t placement_revision_ = 0;
-  bool handling_reset_ = false;  // the heading offset was restarted for the current handling span
+  bool handling_reset_ = false;  // in a handling span, whose start restarted the heading offset
+  void track_handling();
   Eigen::Vector3d last_field_ut_ = Eigen::Vector3d::Zero();
   double mag_accuracy_weight_ = 1.0;  // no accuracy event yet: readings keep their own weight
   TimeNs last_gyro_ns_ = -1;
