@@ -173,9 +173,12 @@ class PhyphoxBuilder {
   PhyphoxBuilder(std::unique_ptr<Container> c, SourceOptions opt) : c_(std::move(c)), opt_(opt) {}
 
   std::unique_ptr<SampleSource> build() {
-    src_ = std::make_unique<MergedSource>(c_->name(), Format::kPhyphox, opt_, c_->total_bytes());
+    const std::string name = c_->entries().size() == 1 ? c_->where(c_->entries().front()) : c_->name();
+    src_ = std::make_unique<MergedSource>(name, Format::kPhyphox, opt_, c_->total_bytes());
     read_meta();
     ReadStats& st = src_->mutable_stats();
+    if (c_->entries().size() == 1)
+      src_->set_hint("one table of a phyphox export: pass the export's folder or zip (with meta/) to read all of it");
     for (const Entry& e : c_->entries()) {
       const std::string p = lower_ascii(e.path);
       const std::string b = lower_ascii(e.base);

@@ -114,7 +114,8 @@ class SensorLoggerBuilder {
   SensorLoggerBuilder(std::unique_ptr<Container> c, SourceOptions opt) : c_(std::move(c)), opt_(opt) {}
 
   std::unique_ptr<SampleSource> build() {
-    src_ = std::make_unique<MergedSource>(c_->name(), Format::kSensorLogger, opt_, c_->total_bytes());
+    const std::string name = c_->entries().size() == 1 ? c_->where(c_->entries().front()) : c_->name();
+    src_ = std::make_unique<MergedSource>(name, Format::kSensorLogger, opt_, c_->total_bytes());
     ReadStats& st = src_->mutable_stats();
     const std::string root = c_->root();
     std::vector<const Entry*> files;
@@ -130,6 +131,8 @@ class SensorLoggerBuilder {
       return e != nullptr && e->size > 0;
     };
     const bool total = has("TotalAcceleration.csv");
+    if (c_->entries().size() == 1)
+      src_->set_hint("one file of a Sensor Logger recording: pass the recording's folder or zip to read all of it");
     for (const Entry* e : files) {
       const std::string b = lower_ascii(e->base);
       if (b == "metadata.csv") continue;

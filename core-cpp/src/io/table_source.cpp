@@ -195,9 +195,16 @@ bool MergedSource::next(Sample& out) {
   } else {
     if (!finished_) {
       finished_ = true;
-      if (opt_.require_samples && stats_.samples == 0)
-        throw IoError(name_, 0, "no samples: " + std::to_string(stats_.skipped_total()) + " rows skipped, " +
-                                    std::to_string(stats_.lines) + " lines read");
+      if (opt_.require_samples && stats_.samples == 0) {
+        std::string why = "no samples: " + std::to_string(stats_.lines) + " lines read, " +
+                          std::to_string(stats_.skipped_total()) + " rows skipped";
+        if (!stats_.issues.empty()) why += " (first: " + stats_.issues.front().to_string() + ")";
+        int n = 0;
+        for (const auto& [what, reason] : stats_.not_used)
+          if (n++ < 3) why += "; not used: " + what + ": " + reason;
+        if (!hint_.empty()) why += "; " + hint_;
+        throw IoError(name_, 0, why);
+      }
     }
     return false;
   }

@@ -77,6 +77,8 @@ class MergedSource : public SampleSource {
   void add_prefix(Sample s) { prefix_.push_back(std::move(s)); }
   std::map<std::string, std::string>& info() { return info_; }
   ReadStats& mutable_stats() { return stats_; }
+  /// Appended to the "no samples" error (e.g. "pass the recording's folder or zip").
+  void set_hint(std::string h) { hint_ = std::move(h); }
 
   bool next(Sample& out) override;
   const ReadStats& stats() const override;
@@ -111,6 +113,7 @@ class MergedSource : public SampleSource {
   std::map<std::string, std::string> info_;
   mutable ReadStats stats_;
   std::map<std::string, std::int64_t> by_type_;
+  std::string hint_;
 };
 
 }  // namespace pdnav::io::detail
