@@ -23,3 +23,35 @@ add_test(NAME io_inspect_game_rotation_and_accuracy
          COMMAND pdnav inspect "${PROJECT_SOURCE_DIR}/tests/fuzz-corpus/log_reader/game_rotation_and_accuracy.txt")
 set_tests_properties(io_inspect_game_rotation_and_accuracy PROPERTIES LABELS "io;cli"
   PASS_REGULAR_EXPRESSION "GameRotationVector +2 .*SensorAccuracy +4 .*value out of range: 1.*wrong field count: 1.*samples: 8 skipped: 2\n")
+
+# Other loggers (docs/log-format.md "Other loggers"): the shared Sensor Logger walk (folder,
+# and a zip made from it at test time with `cmake -E tar --format=zip`), the phyphox and
+# GetSensorData fixtures written from their specs; wrong input is an error.
+set(_io_walk "${PDNAV_SHARED_DATA_DIR}/walk-ethz-sensorlogger/2023-03-17_15-50-47")
+add_test(NAME io_inspect_sensorlogger_folder COMMAND pdnav inspect "${_io_walk}")
+set_tests_properties(io_inspect_sensorlogger_folder PROPERTIES LABELS "io;cli"
+  PASS_REGULAR_EXPRESSION "\\(sensorlogger\\).*Accel +34667 .*Fix +1091 .*Gyro +34648 .*Pressure +3853 .*not used: [^\n]*Gravity.csv.*samples: 178209 skipped: 0\n")
+add_test(NAME io_sensorlogger_zip_make
+         COMMAND "${CMAKE_COMMAND}" -E chdir "${PDNAV_SHARED_DATA_DIR}/walk-ethz-sensorlogger"
+                 "${CMAKE_COMMAND}" -E tar cf "${CMAKE_CURRENT_BINARY_DIR}/ethz-walk.zip" --format=zip 2023-03-17_15-50-47)
+set_tests_properties(io_sensorlogger_zip_make PROPERTIES LABELS "io;cli" FIXTURES_SETUP io_sl_zip)
+add_test(NAME io_inspect_sensorlogger_zip COMMAND pdnav inspect "${CMAKE_CURRENT_BINARY_DIR}/ethz-walk.zip")
+set_tests_properties(io_inspect_sensorlogger_zip PROPERTIES LABELS "io;cli" FIXTURES_REQUIRED io_sl_zip
+  PASS_REGULAR_EXPRESSION "sensorlogger\\).*Accel +34667 .*Fix +1091 .*samples: 178209 skipped: 0\n")
+add_test(NAME io_replay_sensorlogger_zip
+         COMMAND pdnav replay "${CMAKE_CURRENT_BINARY_DIR}/ethz-walk.zip" --out "${CMAKE_CURRENT_BINARY_DIR}/replay-ethz-zip" --quiet)
+set_tests_properties(io_replay_sensorlogger_zip PROPERTIES LABELS "io;cli" FIXTURES_REQUIRED io_sl_zip
+  PASS_REGULAR_EXPRESSION "\\(sensorlogger\\)\nsamples:  178209 \\(skipped lines: 0\\).*reference: gps-fix")
+add_test(NAME io_inspect_phyphox_fixture COMMAND pdnav inspect "${PROJECT_SOURCE_DIR}/tests/data/loggers/phyphox-walk")
+set_tests_properties(io_inspect_phyphox_fixture PROPERTIES LABELS "io;cli"
+  PASS_REGULAR_EXPRESSION "\\(phyphox\\).*Accel +3000 .*Fix +30 .*Gyro +3000 .*Mag +1500 .*Pressure +150 .*samples: 7683 skipped: 0\n")
+add_test(NAME io_inspect_getsensordata_fixture COMMAND pdnav inspect "${PROJECT_SOURCE_DIR}/tests/data/loggers/getsensordata-walk.txt")
+set_tests_properties(io_inspect_getsensordata_fixture PROPERTIES LABELS "io;cli"
+  PASS_REGULAR_EXPRESSION "getsensordata\\).*Accel +1500 .*Fix +30 .*RotationVector +300 .*Truth +4 .*line type 'LIGH' not used: 150.*samples: 5286 skipped: 180\n")
+add_test(NAME io_replay_not_a_log COMMAND pdnav replay /etc/passwd --out "${CMAKE_CURRENT_BINARY_DIR}/replay-not-a-log")
+set_tests_properties(io_replay_not_a_log PROPERTIES LABELS "io;cli" WILL_FAIL TRUE)
+add_test(NAME io_replay_not_a_log_message COMMAND pdnav replay /etc/passwd --out "${CMAKE_CURRENT_BINARY_DIR}/replay-not-a-log")
+set_tests_properties(io_replay_not_a_log_message PROPERTIES LABELS "io;cli"
+  PASS_REGULAR_EXPRESSION "not a recording pdnav reads: expected .*; found first line")
+add_test(NAME io_inspect_one_sensorlogger_csv COMMAND pdnav inspect "${_io_walk}/Accelerometer.csv")
+set_tests_properties(io_inspect_one_sensorlogger_csv PROPERTIES LABELS "io;cli" WILL_FAIL TRUE)

@@ -52,19 +52,39 @@ Column split_column(const std::string& header) {
 /// The experiment clock -> Unix time, piecewise from meta/time.csv (each START/PAUSE row
 /// pins one experiment time to one system time; a sample takes the latest row at or before it).
 struct TimeMap {
-  std::vector<std::pair<double, double>> rows;  // (experiment s, system Unix s)
+  std::vector<std::pair<double, std::int64_t>> rows;  // (experiment s, system Unix ns)
   bool known() const { return !rows.empty(); }
   /// Unix ns of experiment time t_s; false when not representable.
   bool unix_ns(double t_s, std::int64_t& out) const {
-    const std::pair<double, double>* r = &rows.front();
+    const std::pair<double, std::int64_t>* r = &rows.front();
     for (const auto& p : rows)
       if (p.first <= t_s) r = &p;
-    const double ns = (r->second + (t_s - r->first)) * 1e9;
-    if (!(ns > 0.0 && ns < 4.0e18)) return false;
-    out = static_cast<std::int64_t>(std::llround(ns));
-    return true;
+    const double d_ns = (t_s - r->first) * 1e9;  // small: exact to well below a nanosecond
+    if (!(std::fabs(d_ns) < 1e17)) return false;
+    out = r->second + static_cast<std::int64_t>(std::llround(d_ns));
+    return out > 0;
   }
 };
+
+/// "1710000032.250" (Unix seconds, phyphox writes 3 decimals) as exact integer nanoseconds.
+bool unix_text_ns(std::string_view s, char sep, std::int64_t& out) {
+  s = trim(s);
+  const char dec = sep == ',' ? '.' : ',';
+  std::size_t p = s.find(dec);
+  if (p == std::string_view::npos) p = s.find('.');
+  std::int64_t whole = 0, frac = 0;
+  if (!parse_i64(s.substr(0, p), whole) || whole <= 0 || whole > 4000000000LL) return false;
+  if (p != std::string_view::npos) {
+    std::string f(s.substr(p + 1));
+    if (f.size() > 9) f.resize(9);
+    for (char c : f)
+      if (c < '0' || c > '9') return false;
+    f.append(9 - f.size(), '0');
+    if (!parse_i64(f, frac)) return false;
+  }
+  out = whole * 1000000000LL + frac;
+  return true;
+}
 
 /// What one table holds, found from its column names.
 enum class Kind { kNone, kAccel, kGyro, kMag, kPressure, kLocation };
@@ -204,7 +224,7 @@ class PhyphoxBuilder {
       TableFile f(*c_, *e, 0);
       const int k = f.column("property"), v = f.column("value");
       if (k < 0 || v < 0) throw IoError(f.where(), 1, "meta/device.csv without \"property\",\"value\" header");
-      std::string model, brand;
+      std::string model, brand, manufacturer;
       for (;;) {
         bool row = false;
         try {
@@ -217,10 +237,12 @@ class PhyphoxBuilder {
         if (key.find(' ') != std::string::npos) continue;  // per-sensor rows ("accelerometer Resolution")
         if (info.size() < 64) info[key] = val;
         if (key == "deviceModel") model = val;
-        if (key == "deviceBrand" || key == "deviceManufacturer") brand = val;
+        if (key == "deviceManufacturer") manufacturer = val;
+        if (key == "deviceBrand") brand = val;
         if (key == "version") src_->add_prefix(MetaSample{0, "AppVersion", "phyphox " + val});
       }
-      if (!model.empty()) src_->add_prefix(MetaSample{0, "Device", brand.empty() ? model : brand + " " + model});
+      if (manufacturer.empty()) manufacturer = brand;
+      if (!model.empty()) src_->add_prefix(MetaSample{0, "Device", manufacturer.empty() ? model : manufacturer + " " + model});
       st.not_used[f.where()] = "metadata: read into Meta rows";
     }
     if (const Entry* e = c_->find_path("meta/time.csv")) {
@@ -236,12 +258,13 @@ class PhyphoxBuilder {
           continue;
         }
         if (!row) break;
-        double x = 0, s = 0;
-        if (!number(f.field(et), f.sep(), x) || !number(f.field(sy), f.sep(), s) || !std::isfinite(x) || !std::isfinite(s) || s <= 0)
+        double x = 0;
+        std::int64_t sys_ns = 0;
+        if (!number(f.field(et), f.sep(), x) || !std::isfinite(x) || !unix_text_ns(f.field(sy), f.sep(), sys_ns))
           throw IoError(f.where(), f.line_no(), "time mapping row '" + printable(f.field(ev)) + "' has no usable times");
         if (!time_.rows.empty() && x < time_.rows.back().first)
           throw IoError(f.where(), f.line_no(), "experiment time goes backwards in the time mapping");
-        time_.rows.emplace_back(x, s);
+        time_.rows.emplace_back(x, sys_ns);
         if (time_.rows.size() == 1) info["StartSystemTime"] = printable(f.field(f.column("system time text")), 64);
       }
       st.not_used[f.where()] = "time mapping: experiment time -> Unix time";

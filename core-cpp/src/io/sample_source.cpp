@@ -259,12 +259,13 @@ std::unique_ptr<SampleSource> open_memory_source(std::vector<std::pair<std::stri
                                                  Format fmt, SourceOptions opt) {
   if (files.size() == 1 && files[0].first.size() >= 4 &&
       detail::lower_ascii(files[0].first.substr(files[0].first.size() - 4)) == ".zip")
-    return open_container(detail::open_zip_bytes(std::move(files[0].second), name), fmt, opt);
+    return open_container(detail::open_zip_bytes(std::move(files[0].second), files[0].first), fmt, opt);
   if (fmt == Format::kSession || fmt == Format::kGnssLogger || fmt == Format::kGetSensorData) {
     if (files.size() != 1) throw IoError(name, 0, "a text log is one file");
     auto in = std::make_unique<std::istringstream>(std::move(files[0].second));
-    if (fmt == Format::kGetSensorData) return detail::open_getsensordata(std::move(in), name, 0, opt);
-    return std::make_unique<LogSource>(LogReader(std::move(in), name, opt.log), fmt, opt.require_samples);
+    const std::string file = files[0].first;  // messages name the file
+    if (fmt == Format::kGetSensorData) return detail::open_getsensordata(std::move(in), file, 0, opt);
+    return std::make_unique<LogSource>(LogReader(std::move(in), file, opt.log), fmt, opt.require_samples);
   }
   return open_container(detail::open_memory_files(std::move(files), name), fmt, opt);
 }

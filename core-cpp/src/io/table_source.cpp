@@ -178,6 +178,7 @@ void MergedSource::start() {
   started_ = true;
   for (std::size_t i = 0; i < cursors_.size(); ++i)
     if (advance(cursors_[i])) heap_.emplace(sample_time_ns(cursors_[i].head), i);
+  if (heap_.empty() && opt_.require_samples) finish_empty();  // metadata alone is no recording
   const TimeNs t0 = heap_.empty() ? 0 : heap_.top().first;
   for (Sample& s : prefix_) std::visit([t0](auto& x) { x.t_ns = t0; }, s);
 }
@@ -193,7 +194,17 @@ bool MergedSource::next(Sample& out) {
     out = std::move(c.head);
     if (advance(c)) heap_.emplace(sample_time_ns(c.head), i);
   } else {
-    if (!finished_) {
+    finish_empty();
+    return false;
+  }
+  ++stats_.samples;
+  ++by_type_[std::string(line_type_name(out))];
+  return true;
+}
+
+void MergedSource::finish_empty() {
+  {
+    if (!finished_) {  // once
       finished_ = true;
       if (opt_.require_samples && stats_.samples == 0) {
         std::string why = "no samples: " + std::to_string(stats_.lines) + " lines read, " +
@@ -206,11 +217,7 @@ bool MergedSource::next(Sample& out) {
         throw IoError(name_, 0, why);
       }
     }
-    return false;
   }
-  ++stats_.samples;
-  ++by_type_[std::string(line_type_name(out))];
-  return true;
 }
 
 const ReadStats& MergedSource::stats() const {

@@ -99,6 +99,7 @@ class MergedSource : public SampleSource {
   bool advance(Cursor& c);
   void skip(const TableFile& f, const RowSkip& s);
   void start();
+  void finish_empty();  // the "no samples" error when nothing was read (once)
 
   std::string name_;
   Format format_;
