@@ -10,10 +10,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <Eigen/Geometry>
 
 #include "pdnav/io/log_format.h"
 #include "pdnav/io/log_reader.h"
@@ -343,6 +346,60 @@ TEST(SensorLogger, MergeIsTimeOrderedAcrossFiles) {
   const Read r = read_mem({{"TotalAcceleration.csv", a}, {"Magnetometer.csv", m}}, Format::kSensorLogger);
   EXPECT_EQ(r.samples.size(), 40u);
   expect_time_ordered(r);
+}
+
+/// A recording with Orientation.csv in a chosen frame convention, and its gravity and field.
+struct Attitudes {
+  Files files;
+  std::vector<Eigen::Matrix3d> enu_from_dev;
+};
+Attitudes orientation_recording(const Eigen::Matrix3d& world_from_enu, bool inverse, bool garbage = false) {
+  Attitudes a;
+  std::string o = "time,seconds_elapsed,qz,qy,qx,qw,roll,pitch,yaw\n", g = "time,seconds_elapsed,z,y,x\n", m = g;
+  for (int i = 0; i < 200; ++i) {
+    const double t = i * 0.02;
+    const Eigen::Matrix3d r = (Eigen::AngleAxisd(0.5 * t + 0.3, Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(0.2 * std::sin(t), Eigen::Vector3d::UnitX()) *
+                               Eigen::AngleAxisd(0.1 * std::cos(t), Eigen::Vector3d::UnitY())).toRotationMatrix();
+    a.enu_from_dev.push_back(r);
+    Eigen::Quaterniond q(world_from_enu * r);
+    if (inverse) q = q.conjugate();
+    if (garbage) q = Eigen::Quaterniond(std::cos(7.1 * i), std::sin(3.3 * i), std::cos(1.7 * i), std::sin(5.9 * i)).normalized();
+    const Eigen::Vector3d gd = r.transpose() * Eigen::Vector3d(0, 0, 9.80665), md = r.transpose() * Eigen::Vector3d(0, 20, -43);
+    const std::string ts = std::to_string(1700000000000000000 + i * 20000000LL) + "," + std::to_string(t) + ",";
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "%.17g,%.17g,%.17g,%.17g,0,0,0\n", q.z(), q.y(), q.x(), q.w());
+    o += ts + buf;
+    std::snprintf(buf, sizeof buf, "%.17g,%.17g,%.17g\n", gd.z(), gd.y(), gd.x());
+    g += ts + buf;
+    std::snprintf(buf, sizeof buf, "%.17g,%.17g,%.17g\n", md.z(), md.y(), md.x());
+    m += ts + buf;
+  }
+  a.files = {{"Metadata.csv", kMetaAndroid}, {"Orientation.csv", o}, {"Gravity.csv", g}, {"Magnetometer.csv", m}};
+  return a;
+}
+
+TEST(SensorLogger, OrientationFrameFoundFromGravityAndFieldThenRotationVectorIsPhoneToEnu) {
+  Eigen::Matrix3d nwu;  // x north, y west, z up (an "x-north, z-vertical" frame)
+  nwu << 0, 1, 0, -1, 0, 0, 0, 0, 1;
+  Eigen::Matrix3d ned;  // x north, y east, z down
+  ned << 0, 1, 0, 1, 0, 0, 0, 0, -1;
+  for (const auto& [frame, inverse] : {std::pair{Eigen::Matrix3d(Eigen::Matrix3d::Identity()), false},
+                                       std::pair{nwu, false}, std::pair{nwu, true}, std::pair{ned, false}}) {
+    const Attitudes a = orientation_recording(frame, inverse);
+    const Read r = read_mem(a.files, Format::kSensorLogger);
+    const auto rv = all_of<RotationVectorSample>(r);
+    ASSERT_EQ(rv.size(), a.enu_from_dev.size()) << (r.stats.not_used.count("mem/Orientation.csv") ? r.stats.not_used.at("mem/Orientation.csv") : "");
+    for (std::size_t i = 0; i < rv.size(); ++i) {
+      const Eigen::Quaterniond q(rv[i].quat_xyzw[3], rv[i].quat_xyzw[0], rv[i].quat_xyzw[1], rv[i].quat_xyzw[2]);
+      ASSERT_LT((q.toRotationMatrix() - a.enu_from_dev[i]).norm(), 1e-9) << "row " << i;
+    }
+    EXPECT_NE(r.info.at("OrientationFrame").find(inverse ? "world->phone" : "phone->world"), std::string::npos);
+  }
+  // a quaternion unrelated to gravity and field fits no convention: not used, with the figure
+  const Read g = read_mem(orientation_recording(nwu, false, true).files, Format::kSensorLogger);
+  EXPECT_EQ(count_type(g, "RotationVector"), 0);
+  EXPECT_NE(g.stats.not_used.at("mem/Orientation.csv").find("no frame convention fits"), std::string::npos);
 }
 
 // ---- phyphox (fixture written from the spec) ----------------------------------------------

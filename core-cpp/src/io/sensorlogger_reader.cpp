@@ -3,8 +3,13 @@
 // file). Columns are mapped by name (Android writes z,y,x). Conventions from the app's
 // documentation (github.com/tszheichoi/awesome-sensor-logger UNITS.md, COORDINATES.md,
 // CROSSPLATFORM.md); docs/log-format.md "Other loggers" has the mapping table.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <set>
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 #include "io/readers.h"
 #include "io/table_source.h"
@@ -152,7 +157,7 @@ class SensorLoggerBuilder {
       else if (b == "accelerometeruncalibrated.csv") add_uncal<UncalAccelSample>(*e, conv_.ios ? -kStandardGravity : 1.0);
       else if (b == "barometer.csv") barometer(*e);
       else if (b == "location.csv") location(*e);
-      else if (b == "orientation.csv") st.not_used[c_->where(*e)] = orientation_reason_;
+      else if (b == "orientation.csv") orientation(*e);
       else st.not_used[c_->where(*e)] = "nothing the core uses";
     }
     return std::move(src_);
@@ -361,11 +366,148 @@ class SensorLoggerBuilder {
     });
   }
 
+  /// The first rows of a file as (time, values by column name); empty when it lacks a column.
+  std::vector<std::pair<TimeNs, Eigen::Vector4d>> head_rows(const Entry* e, std::initializer_list<const char*> cols,
+                                                           std::size_t n) const {
+    std::vector<std::pair<TimeNs, Eigen::Vector4d>> out;
+    if (e == nullptr || e->size == 0) return out;
+    TableFile f(*c_, *e);
+    if (f.empty_file() || f.column("time") < 0) return out;
+    std::vector<int> idx;
+    for (const char* c : cols) {
+      idx.push_back(f.column(c));
+      if (idx.back() < 0) return out;
+    }
+    while (out.size() < n) {
+      try {
+        if (!f.next_row()) break;
+        check_fields(f);
+        Eigen::Vector4d v(0, 0, 0, 0);
+        for (std::size_t i = 0; i < idx.size(); ++i) v[static_cast<Eigen::Index>(i)] = value(f, idx[i]);
+        out.emplace_back(row_time(f, f.column("time")), v);
+      } catch (const RowSkip&) {
+      }
+    }
+    return out;
+  }
+
+  /// Orientation.csv (qx, qy, qz, qw): the app's documentation names an x-north, z-vertical
+  /// reference frame whose yaw sense differs between platforms, which does not pin down the
+  /// quaternion's frame. It is found from the recording itself: over the first rows, the
+  /// rotation C from the quaternion's world frame to east-north-up (magnetic north) follows
+  /// from the accelerometer's gravity and the magnetometer (TRIAD: up = gravity reading,
+  /// east = field x up), for q as phone -> world and as its inverse; a frame convention is an
+  /// axis permutation with signs, so C is snapped to the nearest of the 24 such rotations. The
+  /// rows become RotationVector (phone -> ENU) = C q when the median disagreement with the
+  /// sensors is below 30 degrees; else the file is listed as not used, with the figure.
+  void orientation(const Entry& e) {
+    ReadStats& st = src_->mutable_stats();
+    const std::string where = c_->where(e);
+    constexpr std::size_t kRows = 300;
+    const auto quats = head_rows(&e, {"qx", "qy", "qz", "qw"}, kRows);
+    const Entry* grav_e = c_->find_path("Gravity.csv");
+    auto grav = head_rows(grav_e, {"x", "y", "z"}, 4 * kRows);
+    if (grav.empty()) grav = head_rows(c_->find_path("TotalAcceleration.csv"), {"x", "y", "z"}, 4 * kRows);
+    const auto mag = head_rows(c_->find_path("Magnetometer.csv"), {"x", "y", "z"}, 4 * kRows);
+    if (quats.size() < 20 || grav.size() < 20 || mag.size() < 20) {
+      st.not_used[where] = "attitude quaternion: too few rows with gravity and magnetometer rows to find its reference frame";
+      return;
+    }
+    const double sign = accel_sign();
+    auto nearest = [](const std::vector<std::pair<TimeNs, Eigen::Vector4d>>& v, TimeNs t) -> const Eigen::Vector4d* {
+      auto it = std::lower_bound(v.begin(), v.end(), t, [](const auto& p, TimeNs x) { return p.first < x; });
+      const std::pair<TimeNs, Eigen::Vector4d>* best = nullptr;
+      if (it != v.end()) best = &*it;
+      if (it != v.begin() && (best == nullptr || t - std::prev(it)->first < best->first - t)) best = &*std::prev(it);
+      if (best == nullptr || std::llabs(best->first - t) > 50000000) return nullptr;  // 50 ms
+      return &best->second;
+    };
+    std::vector<Eigen::Matrix3d> c_direct, c_inverse;
+    for (const auto& [t, qv] : quats) {
+      const Eigen::Vector4d* g = nearest(grav, t);
+      const Eigen::Vector4d* m = nearest(mag, t);
+      if (g == nullptr || m == nullptr) continue;
+      const Eigen::Vector3d up = (sign * g->head<3>()).normalized();
+      const Eigen::Vector3d east = m->head<3>().cross(up);
+      if (east.norm() < 1e-6 || qv.norm() < 0.5) continue;
+      Eigen::Matrix3d enu_from_dev;
+      enu_from_dev.row(0) = east.normalized().transpose();
+      enu_from_dev.row(2) = up.transpose();
+      enu_from_dev.row(1) = up.cross(east.normalized()).transpose();
+      const Eigen::Matrix3d rq = Eigen::Quaterniond(qv[3], qv[0], qv[1], qv[2]).normalized().toRotationMatrix();
+      c_direct.push_back(enu_from_dev * rq.transpose());
+      c_inverse.push_back(enu_from_dev * rq);
+    }
+    if (c_direct.size() < 20) {
+      st.not_used[where] = "attitude quaternion: too few rows near gravity and magnetometer rows to find its reference frame";
+      return;
+    }
+    struct Fit {
+      Eigen::Matrix3d snapped = Eigen::Matrix3d::Identity();
+      double median_deg = 1e9;
+    };
+    auto fit = [](const std::vector<Eigen::Matrix3d>& cs) {
+      Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+      for (const auto& c : cs) sum += c;
+      Fit best;
+      double best_trace = -1e9;
+      // the 24 proper axis permutations with signs
+      const std::array<std::array<int, 3>, 6> perms{{{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}}};
+      for (const auto& p : perms)
+        for (int sgn = 0; sgn < 8; ++sgn) {
+          Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+          for (int r = 0; r < 3; ++r) m(r, p[static_cast<std::size_t>(r)]) = (sgn >> r) & 1 ? -1.0 : 1.0;
+          if (m.determinant() < 0) continue;
+          const double tr = (m.transpose() * sum).trace();
+          if (tr > best_trace) { best_trace = tr; best.snapped = m; }
+        }
+      std::vector<double> ang;
+      for (const auto& c : cs) {
+        const double cosang = std::clamp(((best.snapped.transpose() * c).trace() - 1.0) / 2.0, -1.0, 1.0);
+        ang.push_back(std::acos(cosang) * 180.0 / kPi);
+      }
+      std::nth_element(ang.begin(), ang.begin() + static_cast<std::ptrdiff_t>(ang.size() / 2), ang.end());
+      best.median_deg = ang[ang.size() / 2];
+      return best;
+    };
+    const Fit d = fit(c_direct), inv = fit(c_inverse);
+    const bool inverse = inv.median_deg < d.median_deg;
+    const Fit& f = inverse ? inv : d;
+    char buf[160];
+    if (!(f.median_deg < 30.0)) {
+      std::snprintf(buf, sizeof buf, "attitude quaternion: no frame convention fits the accelerometer and magnetometer "
+                                     "(median disagreement %.0f deg)", f.median_deg);
+      st.not_used[where] = buf;
+      return;
+    }
+    std::snprintf(buf, sizeof buf, "%s; frame found from %zu rows, median disagreement %.1f deg",
+                  inverse ? "world->phone" : "phone->world", c_direct.size(), f.median_deg);
+    src_->info()["OrientationFrame"] = buf;
+    const Eigen::Quaterniond c_enu(f.snapped);
+    auto file = std::make_unique<TableFile>(*c_, e);
+    if (file->empty_file()) return;
+    const int ct = need(*file, "time"), qx = need(*file, "qx"), qy = need(*file, "qy"), qz = need(*file, "qz"),
+              qw = need(*file, "qw");
+    list_unknown_columns(*file, {"time", "seconds_elapsed", "qx", "qy", "qz", "qw", "roll", "pitch", "yaw"}, st);
+    src_->add(std::move(file), [=](const TableFile& t, Sample& out) {
+      check_fields(t);
+      RotationVectorSample r;
+      r.t_ns = row_time(t, ct);
+      r.utc_ms = utc_ms_of(r.t_ns);
+      Eigen::Quaterniond q(value(t, qw), value(t, qx), value(t, qy), value(t, qz));
+      if (!(q.norm() > 0.5 && q.norm() < 1.5)) throw RowSkip{kOutOfRange, "quaternion norm " + std::to_string(q.norm())};
+      q.normalize();
+      const Eigen::Quaterniond enu = c_enu * (inverse ? q.conjugate() : q);
+      r.quat_xyzw = Eigen::Vector4d(enu.x(), enu.y(), enu.z(), enu.w());
+      out = r;
+      return true;
+    });
+  }
+
   std::unique_ptr<Container> c_;
   SourceOptions opt_;
   Conventions conv_;
   std::unique_ptr<MergedSource> src_;
-  std::string orientation_reason_ = "attitude quaternion: reference frame not documented for the rotation vector";
 };
 
 }  // namespace
