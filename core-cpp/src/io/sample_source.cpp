@@ -64,7 +64,6 @@ class LogSource : public SampleSource {
   bool finished_ = false;
 };
 
-bool starts_with(std::string_view s, std::string_view p) { return s.substr(0, p.size()) == p; }
 
 /// GetSensorData line-type tokens (IPIN competition logfile description).
 bool is_gsd_token(std::string_view t) {

@@ -72,12 +72,6 @@ int need(const TableFile& f, const char* name) {
   return c;
 }
 
-int any_of(const TableFile& f, std::initializer_list<const char*> names) {
-  for (const char* n : names)
-    if (const int c = f.column(n); c >= 0) return c;
-  return -1;
-}
-
 struct Xyz {
   int t, x, y, z;
 };
@@ -201,7 +195,7 @@ class SensorLoggerBuilder {
     src_->mutable_stats().not_used[f.where()] = "metadata: read into Meta rows";
   }
 
-  template <class S> void set_vec(S& s, const Eigen::Vector3d& v) {
+  template <class S> static void set_vec(S& s, const Eigen::Vector3d& v) {
     if constexpr (std::is_same_v<S, AccelSample> || std::is_same_v<S, UncalAccelSample>) s.acc_mps2 = v;
     else if constexpr (std::is_same_v<S, GyroSample> || std::is_same_v<S, UncalGyroSample>) s.rate_radps = v;
     else s.field_ut = v;
@@ -212,7 +206,7 @@ class SensorLoggerBuilder {
     if (f->empty_file()) return;
     const Xyz c = xyz_columns(*f);
     list_unknown_columns(*f, kXyzKnown, src_->mutable_stats());
-    src_->add(std::move(f), [this, c, scale](const TableFile& t, Sample& out) {
+    src_->add(std::move(f), [c, scale](const TableFile& t, Sample& out) {
       check_fields(t);
       S s;
       s.t_ns = row_time(t, c.t);
@@ -230,7 +224,7 @@ class SensorLoggerBuilder {
     std::set<std::string> known = kXyzKnown;
     const BiasCols b = bias_columns(*f, known);
     list_unknown_columns(*f, known, src_->mutable_stats());
-    src_->add(std::move(f), [this, c, b, scale](const TableFile& t, Sample& out) {
+    src_->add(std::move(f), [c, b, scale](const TableFile& t, Sample& out) {
       check_fields(t);
       S s;
       s.t_ns = row_time(t, c.t);
@@ -489,7 +483,7 @@ class SensorLoggerBuilder {
     const int ct = need(*file, "time"), qx = need(*file, "qx"), qy = need(*file, "qy"), qz = need(*file, "qz"),
               qw = need(*file, "qw");
     list_unknown_columns(*file, {"time", "seconds_elapsed", "qx", "qy", "qz", "qw", "roll", "pitch", "yaw"}, st);
-    src_->add(std::move(file), [=](const TableFile& t, Sample& out) {
+    src_->add(std::move(file), [ct, qx, qy, qz, qw, c_enu, inverse](const TableFile& t, Sample& out) {
       check_fields(t);
       RotationVectorSample r;
       r.t_ns = row_time(t, ct);

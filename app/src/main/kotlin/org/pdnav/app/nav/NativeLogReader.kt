@@ -1,8 +1,11 @@
 package org.pdnav.app.nav
 
 /**
- * io::LogReader behind a native handle: reads a session log (or a GnssLogger log) back as
- * [SampleBatch]es, in file order, for replay in the app and in the host tests.
+ * io::open_sample_source behind a native handle: reads a recording back as [SampleBatch]es,
+ * in time order, for replay in the app and in the host tests: a session log, a GnssLogger log,
+ * a Sensor Logger or phyphox export (folder or zip) or a GetSensorData log, the format found
+ * from the content (docs/log-format.md section 11). A file no reader recognises is an
+ * IOException naming what was expected and what was found.
  */
 class NativeLogReader(path: String) : AutoCloseable {
     private val h: NativeHandle
