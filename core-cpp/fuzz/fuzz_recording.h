@@ -1,6 +1,7 @@
 // Shared body of the fuzz targets of the multi-file / other-logger readers (fuzz_sensorlogger,
 // fuzz_phyphox, fuzz_getsensordata): arbitrary bytes as a recording through
-// io::open_memory_source, lenient and strict. Input: a zip archive (starts with "PK"), or files
+// io::open_memory_source, lenient and strict. Input: a zip archive (starts with "PK"), a JSON
+// export (starts with '['), or files
 // separated by lines "=== NAME" (text before the first marker is the file `first_name`).
 // Checks, beyond "no crash, no sanitizer report":
 //  - merged readers (Sensor Logger, phyphox) return samples in time order;
@@ -33,6 +34,10 @@ inline std::vector<std::pair<std::string, std::string>> split_files(const std::s
   std::vector<std::pair<std::string, std::string>> files;
   if (bytes.size() >= 2 && bytes[0] == 'P' && bytes[1] == 'K') {
     files.emplace_back("fuzz.zip", bytes);
+    return files;
+  }
+  if (!bytes.empty() && bytes[0] == '[') {  // Sensor Logger's JSON export
+    files.emplace_back("fuzz.json", bytes);
     return files;
   }
   std::string name = first_name, body;

@@ -402,6 +402,45 @@ TEST(SensorLogger, OrientationFrameFoundFromGravityAndFieldThenRotationVectorIsP
   EXPECT_NE(g.stats.not_used.at("mem/Orientation.csv").find("no frame convention fits"), std::string::npos);
 }
 
+TEST(SensorLogger, JsonExportReadsLikeTheCsvFiles) {
+  // the documented JSON layout: one array, records grouped by sensor, every value a string
+  const Files csv = {{"Metadata.csv", kMetaAndroid}, {"Gyroscope.csv", gyro_rows(30)},
+                     {"TotalAcceleration.csv", gyro_rows(25, 1700000000004000000, 12000000)}};
+  std::string json = "[\n";
+  bool first = true;
+  for (const auto& [name, text] : csv) {
+    std::stringstream in(text);
+    std::string header, line;
+    std::getline(in, header);
+    std::vector<std::string> keys;
+    std::stringstream hs(header);
+    for (std::string k; std::getline(hs, k, ',');) keys.push_back(k);
+    while (std::getline(in, line)) {
+      std::stringstream ls(line);
+      json += first ? "  {" : ",\n  {";
+      first = false;
+      json += "\"sensor\": \"" + name.substr(0, name.size() - 4) + "\"";
+      std::size_t i = 0;
+      for (std::string v; std::getline(ls, v, ','); ++i) json += ", \"" + keys[i] + "\": \"" + v + "\"";
+      json += "}";
+    }
+  }
+  json += "\n]\n";
+  const Read from_csv = read_mem(csv, Format::kSensorLogger);
+  const Read from_json = read_mem({{"export.json", json}}, Format::kAuto);
+  EXPECT_EQ(from_json.format, Format::kSensorLogger);
+  EXPECT_EQ(count_type(from_json, "Gyro"), 30);
+  EXPECT_EQ(count_type(from_json, "Accel"), 25);
+  expect_same(from_csv, from_json);
+  // truncated, a record without "sensor", a nested value: errors naming the byte
+  std::string e = error_of([&] { read_mem({{"export.json", json.substr(0, json.size() / 2)}}, Format::kAuto); });
+  EXPECT_NE(e.find("export.json: not a readable Sensor Logger JSON export: JSON byte"), std::string::npos) << e;
+  e = error_of([] { read_mem({{"x.json", "[{\"time\": \"1\"}]"}}, Format::kAuto); });
+  EXPECT_NE(e.find("without \"sensor\""), std::string::npos) << e;
+  e = error_of([] { read_mem({{"x.json", "[{\"sensor\": \"Gyroscope\", \"time\": [1]}]"}}, Format::kAuto); });
+  EXPECT_NE(e.find("nested values"), std::string::npos) << e;
+}
+
 // ---- phyphox (fixture written from the spec) ----------------------------------------------
 
 TEST(Phyphox, FixtureFolderTimeMappingUnitsAndPause) {

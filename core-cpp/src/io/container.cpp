@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -404,6 +405,242 @@ class MemoryContainer : public Container {
   std::map<std::string, std::shared_ptr<const std::string>> data_;
 };
 
+// ---- Sensor Logger JSON export --------------------------------------------------------
+// "an array of objects, each a single record; all records of a sensor grouped together,
+// sorted by time" (awesome-sensor-logger README, "JSON"): [{"sensor": "Accelerometer",
+// "time": "1698501144401773000", "seconds_elapsed": "0.21", "z": "...", ...}, ...].
+// Each contiguous group of one sensor becomes a virtual CSV file "<sensor>.csv" whose stream
+// converts the group's objects to CSV rows on the fly (header: the first object's keys), so
+// the Sensor Logger reader and its k-way merge read it like the folder: one pass to index
+// the groups, then one stream per group, constant memory.
+
+/// Pull parser for a flat JSON array of flat objects.
+class JsonScanner {
+ public:
+  explicit JsonScanner(std::istream& in) : buf_(in.rdbuf()) {}
+  std::uint64_t offset() const { return off_; }
+  const std::string& error() const { return error_; }
+  /// Consumes the opening '['; false (with error()) when the input does not start with one.
+  bool open_array() {
+    skip_ws();
+    if (peek() == '\xEF') { get(); get(); get(); skip_ws(); }  // UTF-8 BOM
+    if (get() != '[') return fail("not a JSON array (no '[' at the start)");
+    return true;
+  }
+  /// Next object of the array: its members in order, and the offset of its '{'. False at the
+  /// end of the array or on an error (error() says which).
+  bool next_object(std::vector<std::pair<std::string, std::string>>& kv, std::uint64_t& start) {
+    kv.clear();
+    skip_ws();
+    int c = peek();
+    if (c == ',') { get(); skip_ws(); c = peek(); }
+    if (c == ']' || c == EOF) {
+      if (c == EOF) fail("the JSON array is not closed (truncated?)");
+      return false;
+    }
+    start = off_;
+    if (get() != '{') return fail("expected '{'");
+    skip_ws();
+    if (peek() == '}') { get(); return true; }
+    for (;;) {
+      std::string k, v;
+      skip_ws();
+      if (!string(k)) return false;
+      skip_ws();
+      if (get() != ':') return fail("expected ':' after a key");
+      skip_ws();
+      if (peek() == '"') {
+        if (!string(v)) return false;
+      } else if (!literal(v)) {
+        return false;
+      }
+      if (kv.size() >= 256) return fail("more than 256 members in one object");
+      kv.emplace_back(std::move(k), std::move(v));
+      skip_ws();
+      const int e = get();
+      if (e == '}') return true;
+      if (e != ',') return fail("expected ',' or '}' in an object");
+    }
+  }
+
+ private:
+  int peek() { const int c = buf_->sgetc(); return c == EOF ? EOF : static_cast<unsigned char>(c); }
+  int get() {
+    const int c = buf_->sbumpc();
+    if (c == EOF) return EOF;
+    ++off_;
+    return static_cast<unsigned char>(c);
+  }
+  void skip_ws() {
+    for (int c = peek(); c == ' ' || c == '\n' || c == '\r' || c == '\t'; c = peek()) get();
+  }
+  bool fail(const std::string& why) {
+    if (error_.empty()) error_ = "JSON byte " + std::to_string(off_) + ": " + why;
+    return false;
+  }
+  bool string(std::string& out) {
+    if (get() != '"') return fail("expected a string");
+    for (;;) {
+      int c = get();
+      if (c == EOF) return fail("string not closed");
+      if (c == '"') return true;
+      if (c == '\\') {
+        c = get();
+        switch (c) {
+          case '"': case '\\': case '/': break;
+          case 'b': c = '\b'; break;
+          case 'f': c = '\f'; break;
+          case 'n': c = '\n'; break;
+          case 'r': c = '\r'; break;
+          case 't': c = '\t'; break;
+          case 'u': {  // kept as '?': no sensor value needs non-ASCII text
+            for (int i = 0; i < 4; ++i)
+              if (!std::isxdigit(get())) return fail("bad \\u escape");
+            c = '?';
+            break;
+          }
+          default: return fail("bad escape");
+        }
+      }
+      if (out.size() >= 4096) return fail("string longer than 4096 bytes");
+      out.push_back(static_cast<char>(c));
+    }
+  }
+  bool literal(std::string& out) {  // number, true, false, null
+    for (int c = peek(); c != EOF && c != ',' && c != '}' && c != ']' && c != ' ' && c != '\n' && c != '\r' && c != '\t';
+         c = peek()) {
+      if (c == '{' || c == '[') return fail("nested values are not part of the export");
+      if (out.size() >= 64) return fail("value longer than 64 bytes");
+      out.push_back(static_cast<char>(get()));
+    }
+    if (out.empty()) return fail("expected a value");
+    if (out == "null") out.clear();
+    return true;
+  }
+
+  std::streambuf* buf_;
+  std::uint64_t off_ = 0;
+  std::string error_;
+};
+
+std::string csv_field(const std::string& v) {
+  if (v.find_first_of(",\"\n\r") == std::string::npos) return v;
+  std::string q = "\"";
+  for (char c : v) {
+    if (c == '"') q += "\"\"";
+    else if (c == '\n' || c == '\r') q += ' ';
+    else q += c;
+  }
+  return q + "\"";
+}
+
+struct JsonGroup {
+  std::string sensor;
+  std::uint64_t offset = 0;  // of the group's first '{'
+  std::vector<std::string> keys;
+};
+
+/// One group as CSV text.
+class JsonGroupBuf : public std::streambuf {
+ public:
+  JsonGroupBuf(std::unique_ptr<std::istream> in, JsonGroup g)
+      : in_(std::move(in)), scan_(*in_), g_(std::move(g)) {
+    line_ = "";
+    for (std::size_t i = 0; i < g_.keys.size(); ++i) line_ += (i ? "," : "") + csv_field(g_.keys[i]);
+    line_ += '\n';
+    setg(line_.data(), line_.data(), line_.data() + line_.size());
+  }
+  const std::string& error() const { return error_; }
+  std::uint64_t consumed() const { return scan_.offset(); }
+
+ protected:
+  int_type underflow() override {
+    if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
+    if (done_) return traits_type::eof();
+    std::uint64_t start = 0;
+    if (!scan_.next_object(kv_, start) || sensor_of(kv_) != g_.sensor) {
+      if (!scan_.error().empty()) error_ = scan_.error();
+      done_ = true;
+      return traits_type::eof();
+    }
+    line_.clear();
+    for (std::size_t i = 0; i < g_.keys.size(); ++i) {
+      if (i) line_ += ',';
+      for (const auto& [k, v] : kv_)
+        if (k == g_.keys[i]) { line_ += csv_field(v); break; }
+    }
+    line_ += '\n';
+    setg(line_.data(), line_.data(), line_.data() + line_.size());
+    return traits_type::to_int_type(*gptr());
+  }
+
+ private:
+  static std::string sensor_of(const std::vector<std::pair<std::string, std::string>>& kv) {
+    for (const auto& [k, v] : kv)
+      if (k == "sensor") return v;
+    return {};
+  }
+  std::unique_ptr<std::istream> in_;
+  JsonScanner scan_;
+  JsonGroup g_;
+  std::vector<std::pair<std::string, std::string>> kv_;
+  std::string line_, error_;
+  bool done_ = false;
+};
+
+class JsonEntryStream : public EntryStream {
+ public:
+  JsonEntryStream(std::unique_ptr<std::istream> in, JsonGroup g) : buf_(std::move(in), std::move(g)), in_(&buf_) {}
+  std::istream& stream() override { return in_; }
+  std::string error() const override { return buf_.error(); }
+  std::uint64_t consumed() const override { return buf_.consumed(); }
+
+ private:
+  JsonGroupBuf buf_;
+  std::istream in_;
+};
+
+class JsonContainer : public Container {
+ public:
+  JsonContainer(std::unique_ptr<Bytes> bytes, std::string name) : Container(std::move(name)), bytes_(std::move(bytes)) {
+    auto in = bytes_->stream_at(0);
+    JsonScanner scan(*in);
+    if (!scan.open_array()) throw IoError(name_, 0, "not a Sensor Logger JSON export: " + scan.error());
+    std::vector<std::pair<std::string, std::string>> kv;
+    std::uint64_t start = 0;
+    while (scan.next_object(kv, start)) {
+      std::string sensor;
+      for (const auto& [k, v] : kv)
+        if (k == "sensor") sensor = v;
+      if (sensor.empty()) throw IoError(name_, 0, "JSON byte " + std::to_string(start) + ": a record without \"sensor\"");
+      if (groups_.empty() || groups_.back().sensor != sensor) {
+        if (groups_.size() >= 256) throw IoError(name_, 0, "more than 256 sensor groups");
+        JsonGroup g;
+        g.sensor = sensor;
+        g.offset = start;
+        for (const auto& [k, v] : kv)
+          if (k != "sensor") g.keys.push_back(k);
+        groups_.push_back(std::move(g));
+        Entry e;
+        e.path = e.base = sensor + ".csv";
+        entries_.push_back(e);
+      }
+      entries_.back().size += scan.offset() - start;
+    }
+    if (!scan.error().empty()) throw IoError(name_, 0, "not a readable Sensor Logger JSON export: " + scan.error());
+  }
+  std::unique_ptr<EntryStream> open(const Entry& e) const override {
+    const auto i = static_cast<std::size_t>(&e - entries_.data());
+    if (i >= groups_.size()) throw IoError(where(e), 0, "no such group");
+    return std::make_unique<JsonEntryStream>(bytes_->stream_at(groups_[i].offset), groups_[i]);
+  }
+  std::string where(const Entry& e) const override { return name_ + ":" + e.path; }
+
+ private:
+  std::unique_ptr<Bytes> bytes_;
+  std::vector<JsonGroup> groups_;
+};
+
 }  // namespace
 
 std::uint64_t Container::total_bytes() const {
@@ -461,6 +698,23 @@ std::unique_ptr<Container> open_zip_bytes(std::string bytes, std::string name) {
 
 std::unique_ptr<Container> open_memory_files(std::vector<std::pair<std::string, std::string>> files, std::string name) {
   return std::make_unique<MemoryContainer>(std::move(files), std::move(name));
+}
+
+std::unique_ptr<Container> open_json_file(const std::string& path) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) throw IoError(path, 0, "cannot open: " + ec.message());
+  return std::make_unique<JsonContainer>(std::make_unique<FileBytes>(path, size), path);
+}
+
+std::unique_ptr<Container> open_json_bytes(std::string bytes, std::string name) {
+  return std::make_unique<JsonContainer>(std::make_unique<StringBytes>(std::move(bytes)), std::move(name));
+}
+
+bool looks_like_sensorlogger_json(const std::string& head) {
+  std::size_t i = head.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+  while (i < head.size() && (head[i] == ' ' || head[i] == '\n' || head[i] == '\r' || head[i] == '\t')) ++i;
+  return i < head.size() && head[i] == '[' && head.find("\"sensor\"") != std::string::npos;
 }
 
 bool looks_like_zip(const std::string& b) {

@@ -67,6 +67,12 @@ std::unique_ptr<Container> open_zip_bytes(std::string bytes, std::string name);
 /// Files in memory: (path, bytes).
 std::unique_ptr<Container> open_memory_files(std::vector<std::pair<std::string, std::string>> files,
                                              std::string name);
+/// Sensor Logger's JSON export (one array of records grouped by sensor) as virtual CSV files
+/// "<sensor>.csv", converted on the fly; throws IoError when it is not such an array.
+std::unique_ptr<Container> open_json_file(const std::string& path);
+std::unique_ptr<Container> open_json_bytes(std::string bytes, std::string name);
+/// A JSON array whose first bytes hold a "sensor" key.
+bool looks_like_sensorlogger_json(const std::string& first_bytes);
 /// True when the first bytes are a zip local-file or end-of-central-directory signature.
 bool looks_like_zip(const std::string& first_bytes);
 

@@ -33,7 +33,7 @@ constexpr std::array<FormatName, 6> kNames{{{Format::kAuto, "auto"},
 
 constexpr const char* kExpected =
     "expected a pdnav session log or GnssLogger log (text, lines 'Type,...'), a Sensor Logger or "
-    "phyphox CSV export (folder or zip), or a GetSensorData log (text, lines 'ACCE;...')";
+    "phyphox CSV export (folder or zip), a Sensor Logger JSON export, or a GetSensorData log (text, lines 'ACCE;...')";
 
 /// The LogReader as a SampleSource; a log that yields no sample is an error.
 class LogSource : public SampleSource {
@@ -217,6 +217,7 @@ Format detect_format(const std::string& path) {
     if (f == Format::kAuto) not_recognised(path, found);
     return f;
   }
+  if (detail::looks_like_sensorlogger_json(head)) return Format::kSensorLogger;
   if (is_ole2(head))
     throw IoError(path, 0, "an Excel 97 workbook (.xls; phyphox's Excel export) is not read: export the experiment "
                            "as CSV (folder or zip) instead");
@@ -233,6 +234,8 @@ std::unique_ptr<SampleSource> open_sample_source(const std::string& path, Format
   if (fs::is_directory(st)) return open_container(detail::open_folder(path), fmt, opt);
   const std::string head = read_head(path, 1u << 16);
   if (detail::looks_like_zip(head)) return open_container(detail::open_zip_file(path), fmt, opt);
+  if (detail::looks_like_sensorlogger_json(head) && (fmt == Format::kAuto || fmt == Format::kSensorLogger))
+    return open_container(detail::open_json_file(path), Format::kSensorLogger, opt);
   if (fmt == Format::kAuto) fmt = detect_format(path);
   switch (fmt) {
     case Format::kSession:
@@ -259,6 +262,9 @@ std::unique_ptr<SampleSource> open_memory_source(std::vector<std::pair<std::stri
   if (files.size() == 1 && files[0].first.size() >= 4 &&
       detail::lower_ascii(files[0].first.substr(files[0].first.size() - 4)) == ".zip")
     return open_container(detail::open_zip_bytes(std::move(files[0].second), files[0].first), fmt, opt);
+  if (files.size() == 1 && files[0].first.size() >= 5 &&
+      detail::lower_ascii(files[0].first.substr(files[0].first.size() - 5)) == ".json")
+    return open_container(detail::open_json_bytes(std::move(files[0].second), files[0].first), fmt, opt);
   if (fmt == Format::kSession || fmt == Format::kGnssLogger || fmt == Format::kGetSensorData) {
     if (files.size() != 1) throw IoError(name, 0, "a text log is one file");
     auto in = std::make_unique<std::istringstream>(std::move(files[0].second));
