@@ -55,3 +55,21 @@ set_tests_properties(io_replay_not_a_log_message PROPERTIES LABELS "io;cli"
   PASS_REGULAR_EXPRESSION "not a recording pdnav reads: expected .*; found first line")
 add_test(NAME io_inspect_one_sensorlogger_csv COMMAND pdnav inspect "${_io_walk}/Accelerometer.csv")
 set_tests_properties(io_inspect_one_sensorlogger_csv PROPERTIES LABELS "io;cli" WILL_FAIL TRUE)
+
+# `pdnav import` -> `pdnav replay` equals `pdnav replay` of the recording itself (track.csv
+# compared byte for byte), on the phyphox and GetSensorData fixtures.
+foreach(_fx phyphox-walk getsensordata-walk.txt)
+  string(REGEX REPLACE "[^a-z]" "_" _n "${_fx}")
+  set(_in "${PROJECT_SOURCE_DIR}/tests/data/loggers/${_fx}")
+  set(_d "${CMAKE_CURRENT_BINARY_DIR}/import-${_n}")
+  add_test(NAME io_import_${_n} COMMAND pdnav import "${_in}" -o "${_d}.log")
+  set_tests_properties(io_import_${_n} PROPERTIES LABELS "io;cli" FIXTURES_SETUP io_imp_${_n}
+    PASS_REGULAR_EXPRESSION "-> [^\n]*: [0-9]+ samples")
+  add_test(NAME io_import_replay_direct_${_n} COMMAND pdnav replay "${_in}" --out "${_d}-direct" --quiet)
+  add_test(NAME io_import_replay_imported_${_n} COMMAND pdnav replay "${_d}.log" --out "${_d}-imported" --quiet)
+  set_tests_properties(io_import_replay_direct_${_n} io_import_replay_imported_${_n} PROPERTIES LABELS "io;cli"
+    FIXTURES_REQUIRED io_imp_${_n} FIXTURES_SETUP io_imp_replayed_${_n})
+  add_test(NAME io_import_replay_identical_${_n}
+           COMMAND "${CMAKE_COMMAND}" -E compare_files "${_d}-direct/track.csv" "${_d}-imported/track.csv")
+  set_tests_properties(io_import_replay_identical_${_n} PROPERTIES LABELS "io;cli" FIXTURES_REQUIRED io_imp_replayed_${_n})
+endforeach()
