@@ -9,7 +9,6 @@
 #include <set>
 
 #include <Eigen/Geometry>
-#include <Eigen/SVD>
 
 #include "io/readers.h"
 #include "io/table_source.h"
