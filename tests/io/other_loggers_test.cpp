@@ -338,6 +338,15 @@ TEST(SensorLogger, IosConventionsSignAndUnits) {
   EXPECT_NEAR(all_of<UncalAccelSample>(s)[0].acc_mps2.z(), -1.0, 1e-12);
 }
 
+TEST(SensorLogger, RecordingFolderIsTheOneWithTheCsvFilesNotTheImages) {
+  // a zip of the recording with a Camera/ folder holding more files than the sensor folder
+  Files files{{"rec/Metadata.csv", kMetaAndroid}, {"rec/Gyroscope.csv", gyro_rows(4)}};
+  for (int i = 0; i < 5; ++i) files.emplace_back("rec/Camera/" + std::to_string(1700000000000 + i) + ".jpg", "\xFF\xD8jpeg");
+  const Read r = read_mem({{"rec.zip", test::make_zip(files)}}, Format::kAuto);
+  EXPECT_EQ(count_type(r, "Gyro"), 4);
+  EXPECT_EQ(r.stats.not_used.at("rec.zip:rec/Camera/1700000000000.jpg"), "outside the recording's folder");
+}
+
 TEST(SensorLogger, MergeIsTimeOrderedAcrossFiles) {
   // two files, interleaved times, one sample each 10 ms and 7 ms
   std::string a = "time,seconds_elapsed,z,y,x\n", m = a;

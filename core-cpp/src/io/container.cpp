@@ -661,8 +661,14 @@ const Entry* Container::find(const std::string& base) const {
 }
 
 std::string Container::root() const {
+  // the folder with the most CSV files (a Camera/ folder of images does not count)
   std::map<std::string, int> n;
-  for (const Entry& e : entries_) ++n[dir_of(e.path)];
+  for (const Entry& e : entries_) {
+    const std::string b = lower(e.base);
+    if (b.size() > 4 && b.compare(b.size() - 4, 4, ".csv") == 0) ++n[dir_of(e.path)];
+  }
+  if (n.empty())
+    for (const Entry& e : entries_) ++n[dir_of(e.path)];
   std::string best;
   int most = -1;
   for (const auto& [d, k] : n)

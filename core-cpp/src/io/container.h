@@ -47,7 +47,7 @@ class Container {
   const Entry* find(const std::string& base) const;
   /// The entry at `path` relative to the folder holding the recording's files (case-insensitive).
   const Entry* find_path(const std::string& rel) const;
-  /// The folder (inside the container) holding the most entries: the recording's root.
+  /// The folder (inside the container) holding the most CSV files: the recording's root.
   std::string root() const;
 
  protected:
