@@ -611,6 +611,8 @@ TEST(SampleSource, DetectsFormatsFromContentAndRefusesTheRest) {
   const std::string e = error_of([&] { io::open_sample_source(tmp.string()); });
   EXPECT_NE(e.find("expected a pdnav session log"), std::string::npos) << e;
   EXPECT_NE(e.find("found first line 'root:x:0:0"), std::string::npos) << e;
+  std::ofstream(tmp, std::ios::trunc) << "% a MATLAB script\nx = 1;\n";  // '%' comments alone are not GetSensorData
+  EXPECT_NE(error_of([&] { io::open_sample_source(tmp.string()); }).find("found first line '% a MATLAB script'"), std::string::npos);
   std::ofstream(tmp, std::ios::trunc).flush();
   EXPECT_NE(error_of([&] { io::open_sample_source(tmp.string()); }).find("empty file"), std::string::npos);
   fs::remove(tmp);

@@ -99,7 +99,10 @@ Format sniff_text(const std::string& head, std::string& found) {
       if (std::find(types.begin(), types.end(), tok) != types.end()) ++log_lines;
       continue;
     }
-    if (t.front() == '%') { ++gsd_lines; continue; }  // GetSensorData comment header
+    if (t.front() == '%') {  // GetSensorData comment header (alone it proves nothing: LaTeX, MATLAB ...)
+      if (t.find("GetSensorData") != std::string_view::npos || t.find("LogFile") != std::string_view::npos) ++gsd_lines;
+      continue;
+    }
     const std::string_view tok = t.substr(0, std::min(t.find_first_of(",;"), t.size()));
     if (t.size() > tok.size() && t[tok.size()] == ';' && is_gsd_token(tok)) ++gsd_lines;
     else if (t.size() > tok.size() && t[tok.size()] == ',' && std::find(types.begin(), types.end(), tok) != types.end()) ++log_lines;
