@@ -101,6 +101,18 @@ class RouteAndStepsBridgeTest {
     }
 
     @Test
+    fun nullAndClosedHandlesThrowIllegalState() {
+        assertFailsWith<IllegalStateException> { NativeBridge.navTakeSteps(0L) }
+        assertFailsWith<IllegalStateException> { NativeBridge.navFinish(0L) }
+        assertFailsWith<IllegalStateException> { NativeBridge.routeShortest(0L, 42.5, 1.5, 42.5, 1.5) }
+        assertFailsWith<IllegalStateException> { NativeBridge.routeClose(0L) }
+        val nav = NativeNavigator(NavigatorConfig(), 1L)
+        nav.close()
+        assertFailsWith<IllegalStateException> { nav.takeSteps() }
+        assertFailsWith<IllegalStateException> { nav.finish() }
+    }
+
+    @Test
     fun geoInverseIsTheWgs84Geodesic() {
         // one degree of latitude at the equator: 110574.389 m (WGS84), bearing north
         val (d, b) = NativeRouter.geoInverse(0.0, 10.0, 1.0, 10.0)
