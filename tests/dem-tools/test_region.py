@@ -254,6 +254,8 @@ class RegionErrorsTest(unittest.TestCase):
                           "--center needs --radius")
         self.assert_error("r.pdnav-region", ["--osm", osm(), "--dem", srtm(), "--center", "42.5;1.5",
                                              "--radius", "300"], "--center: expected 2 numbers")
+        self.assert_error("r.pdnav-region", ["--osm", osm(), "--dem", srtm(), "--center", "42.5,1.5",
+                                             "--radius", "300", "--name", "../escape"], "bad region name")
         self.assert_error("r.pdnav-region", ["--osm", osm(), "--dem", os.path.join(SCRATCH, "none.tif"),
                                              "--center", "42.5,1.5", "--radius", "300"], "no such DEM raster")
 
