@@ -119,6 +119,9 @@ def osm_extent_lonlat(path):
     if ds is None or ds.GetLayerByName("lines") is None or ds.GetLayerByName("multipolygons") is None:
         raise BasemapError(f"{path}: not an OSM extract (needs the GDAL OSM driver's lines and "
                            "multipolygons layers)")
+    def plausible(e):  # an .osm file without <bounds> gives an undefined extent (GDAL 3.6)
+        return -180 <= e[0] < e[1] <= 180 and -90 <= e[2] < e[3] <= 90
+
     ext = None
     for name in ("lines", "multipolygons", "points"):
         lyr = ds.GetLayerByName(name)
@@ -126,8 +129,21 @@ def osm_extent_lonlat(path):
             e = lyr.GetExtent(force=1)  # (minx, maxx, miny, maxy), EPSG:4326 lon/lat
         except RuntimeError:
             continue
+        if not plausible(e):
+            continue
         ext = e if ext is None else (min(ext[0], e[0]), max(ext[1], e[1]),
                                      min(ext[2], e[2]), max(ext[3], e[3]))
+    if ext is None:  # no header bounds: the envelope of the features themselves
+        ds = gdal.OpenEx(path, gdal.OF_VECTOR)
+        for name in ("points", "lines", "multipolygons"):
+            lyr = ds.GetLayerByName(name)
+            for feat in lyr:
+                g = feat.GetGeometryRef()
+                if g is None or g.IsEmpty():
+                    continue
+                e = g.GetEnvelope()
+                ext = e if ext is None else (min(ext[0], e[0]), max(ext[1], e[1]),
+                                             min(ext[2], e[2]), max(ext[3], e[3]))
     if ext is None:
         raise BasemapError(f"{path}: the OSM extract holds no features")
     return ext[0], ext[2], ext[1], ext[3]
@@ -298,6 +314,8 @@ def cmd_render(args):
         raise BasemapError("--detail-zoom must be within --min-zoom..--max-zoom+1")
     if args.detail_radius is not None and not args.detail_radius > 0:
         raise BasemapError("--detail-radius must be > 0 metres")
+    if not args.attribution.strip():
+        raise BasemapError("--attribution must not be empty (ODbL: the map must credit OpenStreetMap)")
     if args.metatile < 1 or args.metatile > 16:
         raise BasemapError("--metatile must be 1..16")
     try:
@@ -344,7 +362,7 @@ def cmd_render(args):
                                 f"z{args.min_zoom}-{args.detail_zoom - 1} whole area, "
                                 f"z{args.detail_zoom}-{args.max_zoom} within {detail.xmax:.0f} m "
                                 "of the centre"),
-                "attribution": ATTRIBUTION,
+                "attribution": args.attribution,
                 "bounds": ",".join(f"{v:.6f}" for v in box),
                 "center": f"{area.lon0:.6f},{area.lat0:.6f},{min(15, args.max_zoom)}",
                 "minzoom": str(args.min_zoom), "maxzoom": str(args.max_zoom),
@@ -449,6 +467,8 @@ def build_parser():
                    help="Mapnik image format of the tiles (default png256, as the OSM tile servers)")
     r.add_argument("--max-tiles", type=int, default=60000)
     r.add_argument("--name", default="pdnav basemap")
+    r.add_argument("--attribution", default=ATTRIBUTION,
+                   help="text to show on the map (MBTiles metadata 'attribution'; always written)")
     r.add_argument("--quiet", action="store_true")
     r.set_defaults(func=cmd_render)
     p = sub.add_parser("preview", help="PNG mosaic of zoom levels of an MBTiles")

@@ -49,3 +49,43 @@ if(NOT ANDROID)
     find_package(benchmark 1.7 REQUIRED CONFIG)
   endif()
 endif()
+
+# GeographicLib (MIT): the geodesic inverse problem (Karney 2013) behind geo::geodesic_inverse.
+# Host: Debian's libgeographiclib-dev; NDK: the same version built statically from its tag
+# (PDNAV_GEOGRAPHICLIB_FROM_SOURCE=ON tries that path on the host; with no network, point
+# FETCHCONTENT_SOURCE_DIR_GEOGRAPHICLIB at a checkout of the tag).
+if(ANDROID)
+  set(_pdnav_gl_default ON)
+else()
+  set(_pdnav_gl_default OFF)
+endif()
+option(PDNAV_GEOGRAPHICLIB_FROM_SOURCE "build GeographicLib from its pinned tag (the NDK path)" ${_pdnav_gl_default})
+if(NOT TARGET pdnav_geographiclib)
+  add_library(pdnav_geographiclib INTERFACE)
+  if(NOT PDNAV_GEOGRAPHICLIB_FROM_SOURCE)
+    find_path(PDNAV_GEOGRAPHICLIB_INCLUDE GeographicLib/Geodesic.hpp)
+    find_library(PDNAV_GEOGRAPHICLIB_LIBRARY GeographicLib)
+    if(NOT PDNAV_GEOGRAPHICLIB_INCLUDE OR NOT PDNAV_GEOGRAPHICLIB_LIBRARY)
+      message(FATAL_ERROR "pdnav: GeographicLib not found (tools/setup installs libgeographiclib-dev)")
+    endif()
+    target_include_directories(pdnav_geographiclib SYSTEM INTERFACE "${PDNAV_GEOGRAPHICLIB_INCLUDE}")
+    target_link_libraries(pdnav_geographiclib INTERFACE "${PDNAV_GEOGRAPHICLIB_LIBRARY}")
+  else()
+    FetchContent_Declare(geographiclib
+      GIT_REPOSITORY https://github.com/geographiclib/geographiclib.git
+      GIT_TAG v2.1.2  # same version as Debian bookworm's libgeographiclib-dev
+      GIT_SHALLOW TRUE)
+    FetchContent_GetProperties(geographiclib)
+    if(NOT geographiclib_POPULATED)
+      FetchContent_Populate(geographiclib)
+    endif()
+    # static, no tools/docs in the default build (EXCLUDE_FROM_ALL: only what the core links)
+    set(BUILD_SHARED_LIBS OFF)
+    set(BUILD_BOTH_LIBS OFF)
+    set(BUILD_DOCUMENTATION OFF)
+    set(BUILD_MANPAGES OFF)
+    add_subdirectory("${geographiclib_SOURCE_DIR}" "${geographiclib_BINARY_DIR}" EXCLUDE_FROM_ALL)
+    set_target_properties(GeographicLib_STATIC PROPERTIES POSITION_INDEPENDENT_CODE ON)
+    target_link_libraries(pdnav_geographiclib INTERFACE GeographicLib::GeographicLib_STATIC)
+  endif()
+endif()
