@@ -40,6 +40,9 @@ class MapController(context: Context, val map: MapView) {
     private val engineDots = EngineOverlay()
     private val fixCircle = Polygon(map)
     private val fixMarker = Marker(map)
+    /** Go-to: the shortest walkway route (core router) and the place it leads to. */
+    val routeLine = Polyline(map)
+    private val targetMarker = Marker(map)
     private val density = context.resources.displayMetrics.density
     var showParticles = true
 
@@ -72,6 +75,16 @@ class MapController(context: Context, val map: MapView) {
         ellipse.outlinePaint.strokeWidth = 3f
         trackLine.outlinePaint.color = Color.argb(220, 217, 80, 30)
         trackLine.outlinePaint.strokeWidth = 6f
+        routeLine.outlinePaint.color = ROUTE_COLOR
+        routeLine.outlinePaint.strokeWidth = 5f * density
+        routeLine.infoWindow = null
+        targetMarker.setAnchor(Marker.ANCHOR_CENTER, Marker.ANCHOR_CENTER)
+        targetMarker.icon = android.graphics.drawable.BitmapDrawable(context.resources, dotBitmap(ROUTE_COLOR, density * 1.4f))
+        targetMarker.title = "Go to"
+        map.overlays.add(routeLine)
+        map.overlays.add(targetMarker)
+        routeLine.isEnabled = false
+        targetMarker.isEnabled = false
         map.overlays.add(trackLine)
         map.overlays.add(fixCircle)
         map.overlays.add(ellipse)
@@ -116,6 +129,28 @@ class MapController(context: Context, val map: MapView) {
     }
 
     val graphEdgeCount: Int get() = graphLines.size
+
+    /** Go-to: draws [route] (lat, lon points) and the place; null hides them. */
+    fun showGoTo(targetLatDeg: Double, targetLonDeg: Double, route: List<DoubleArray>?) {
+        if (!targetLatDeg.isFinite()) {
+            routeLine.isEnabled = false
+            targetMarker.isEnabled = false
+            map.invalidate()
+            return
+        }
+        targetMarker.position = GeoPoint(targetLatDeg, targetLonDeg)
+        targetMarker.isEnabled = true
+        if (route != null && route.size >= 2) {
+            routeLine.setPoints(route.map { GeoPoint(it[0], it[1]) })
+            routeLine.isEnabled = true
+        } else {
+            routeLine.isEnabled = false
+        }
+        map.invalidate()
+    }
+
+    val routePointCount: Int get() = if (routeLine.isEnabled) routeLine.actualPoints.size else 0
+    val targetShown: Boolean get() = targetMarker.isEnabled
 
     /** Area the basemap covers, once loaded. */
     var basemapBounds: GeoBounds? = null
@@ -234,6 +269,8 @@ class MapController(context: Context, val map: MapView) {
 
     companion object {
         private val FIX_COLOR = Color.rgb(120, 60, 200)
+        /** Go-to route and place: a saturated blue-green no basemap layer uses. */
+        val ROUTE_COLOR = Color.rgb(0, 150, 200)
 
         /** Colour of each engine (EngineKind order): none, DR, terrain, route, GNSS. */
         val ENGINE_COLORS = intArrayOf(Color.GRAY, Color.rgb(230, 140, 0), Color.rgb(40, 160, 60),

@@ -67,4 +67,23 @@ object NativeBridge {
     @JvmStatic external fun graphPolylines(path: String?): DoubleArray
     /** DEM tile bounds: min lat, min lon, max lat, max lon (degrees). */
     @JvmStatic external fun demBounds(path: String?): DoubleArray
+
+    // ---- issue 29 (interface-29.md): routing, per-step estimates, finish, geodesic inverse ----
+    /** A loaded walkway graph + shortest-path router (owned by [NativeRouter]). */
+    @JvmStatic external fun routeOpen(graphPath: String?): Long
+    @JvmStatic external fun routeClose(handle: Long)
+    /**
+     * Shortest walkway path: [length_m, from_snap_m, to_snap_m, lat0, lon0, lat1, lon1, ...];
+     * empty when no path exists; IllegalArgumentException for non-finite input.
+     */
+    @JvmStatic external fun routeShortest(handle: Long, fromLat: Double, fromLon: Double, toLat: Double, toLon: Double): DoubleArray
+    /**
+     * Per-step estimates since the last call, 8 per step: t_ns (as double), lat, lon,
+     * sigma_east_m, sigma_north_m, corr_en, heading_rad, distance_m.
+     */
+    @JvmStatic external fun navTakeSteps(handle: Long): DoubleArray
+    /** Navigator::finish(): end of input (releases short walks, final estimate). */
+    @JvmStatic external fun navFinish(handle: Long)
+    /** Geodesic inverse on WGS84: [distance_m, initial_bearing_rad]. */
+    @JvmStatic external fun geoInverse(lat1: Double, lon1: Double, lat2: Double, lon2: Double): DoubleArray
 }

@@ -50,6 +50,12 @@ class NativeNavigator(config: NavigatorConfig, seed: Long) : AutoCloseable, Samp
         (flat.indices step 4).map { ModeChange(flat[it].toLong(), flat[it + 1], flat[it + 2], flat[it + 3]) }
     }
 
+    /** Per-step estimates since the last call (issue 29), oldest first. */
+    fun takeSteps(): List<StepEstimate> = synchronized(h) { StepEstimate.parse(NativeBridge.navTakeSteps(h.get())) }
+
+    /** End of input: the core releases short walks and makes its final estimate. */
+    fun finish() = synchronized(h) { NativeBridge.navFinish(h.get()) }
+
     override fun close() {
         registration.unregister()
         h.close()
