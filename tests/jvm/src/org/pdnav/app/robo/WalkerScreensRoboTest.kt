@@ -28,6 +28,7 @@ import org.pdnav.app.ui.PlacesActivity
 import org.pdnav.app.ui.RegionsActivity
 import org.pdnav.app.walk.WalkState
 import org.pdnav.app.walk.WalkTracker
+import org.pdnav.app.walk.remainingM
 import org.robolectric.Robolectric
 import org.robolectric.RobolectricTestRunner
 import org.robolectric.RuntimeEnvironment
@@ -237,10 +238,10 @@ class WalkerScreensRoboTest {
             assertEquals(g.uncertain, g.sigmaM >= WalkTracker.UNCERTAIN_RATIO * g.straightM, "uncertainty rule")
             val route = assertNotNull(g.route, "a walkway route at ${g.tNs}")
             // along the graph: every vertex on a known edge, the length that of the polyline
-            for (p in route.points) assertTrue(toGraphM(edges, p[0], p[1]) < 1.0, "route vertex ${p[0]}, ${p[1]} is ${toGraphM(edges, p[0], p[1])} m off the graph")
+            for (p in route.points) assertTrue(toGraphM(edges, p.first, p.second) < 1.0, "route vertex $p is ${toGraphM(edges, p.first, p.second)} m off the graph")
             var len = 0.0
             for (k in 1 until route.points.size) {
-                val e = en(route.points[k - 1][0], route.points[k - 1][1], route.points[k][0], route.points[k][1])
+                val e = en(route.points[k - 1].first, route.points[k - 1].second, route.points[k].first, route.points[k].second)
                 len += hypot(e[0], e[1])
             }
             assertEquals(len, route.lengthM, 0.01 * route.lengthM + 0.5, "route length = its polyline")
@@ -259,8 +260,8 @@ class WalkerScreensRoboTest {
         activity.showWalk(w)
         // frame the walker and the place
         activity.map.map.zoomToBoundingBox(org.osmdroid.util.BoundingBox.fromGeoPoints(
-            (g.route!!.points + listOf(doubleArrayOf(hut.latDeg, hut.lonDeg), doubleArrayOf(w.step!!.latDeg, w.step!!.lonDeg)))
-                .map { GeoPoint(it[0], it[1]) }), false, 60)
+            (g.route!!.points + listOf(hut.latDeg to hut.lonDeg, w.step!!.latDeg to w.step!!.lonDeg))
+                .map { GeoPoint(it.first, it.second) }), false, 60)
         idle()
         val decor = activity.window.decorView
         val mapView = activity.findViewById<MapView>(R.id.map_view)
@@ -279,7 +280,7 @@ class WalkerScreensRoboTest {
         for (y in mapRect.top until mapRect.bottom) for (x in mapRect.left until mapRect.right) if (pic.getPixel(x, y) != without.getPixel(x, y)) drawn += Point(x, y)
         assertTrue(drawn.size > 200, "route pixels: ${drawn.size}")
         val loc = IntArray(2).also { mapView.getLocationInWindow(it) }
-        val verts = g.route!!.points.map { mapView.projection.toPixels(GeoPoint(it[0], it[1]), null) }.map { Point(it.x + loc[0], it.y + loc[1]) }
+        val verts = g.route!!.points.map { mapView.projection.toPixels(GeoPoint(it.first, it.second), null) }.map { Point(it.x + loc[0], it.y + loc[1]) }
             .filter { mapRect.contains(it.x, it.y) }
         assertTrue(verts.size >= 3, "route on screen: ${verts.size} vertices")
         val near = verts.count { v -> drawn.any { hypot((it.x - v.x).toDouble(), (it.y - v.y).toDouble()) <= 4.0 } }

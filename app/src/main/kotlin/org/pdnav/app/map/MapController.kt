@@ -206,6 +206,11 @@ class MapController(context: Context, val map: MapView) {
         map.setTileSource(source)
         map.setUseDataConnection(false)
         basemapBounds = MbtilesBounds.read(file)?.also { centerOn(it) }
+        // offline tiles only: never zoom past the deepest zoom the file has (blank grid there)
+        MbtilesBounds.maxZoom(file)?.let { z ->
+            map.maxZoomLevel = z.toDouble()
+            if (map.zoomLevelDouble > z) map.controller.setZoom(z.toDouble())
+        }
         return true
     }
 

@@ -2,8 +2,8 @@ package org.pdnav.app.nav
 
 /**
  * The raw natives of libpdnav_jni (core-cpp/jni/bridge.cpp, registered in JNI_OnLoad).
- * Only [NativeNavigator], [NativeRecorder] and [NativeLogReader] call these; they own the
- * handles. A handle of 0 (closed or never opened) makes every call throw
+ * Only [NativeNavigator], [NativeRecorder], [NativeLogReader] and [NativeRouter] call the
+ * handle natives; they own the handles ([geoInverse] takes none). A handle of 0 (closed or never opened) makes every call throw
  * IllegalStateException; C++ exceptions arrive as IllegalArgumentException, IOException or
  * RuntimeException. Array arguments are nullable on purpose: the bridge must reject null
  * with IllegalArgumentException rather than crash, and the misuse tests check that.
@@ -42,6 +42,18 @@ object NativeBridge {
     @JvmStatic external fun navIgnored(handle: Long): Array<String>
     /** Fused-estimate hand-overs, flat: tNs, from, to, reason, ... */
     @JvmStatic external fun navModeChanges(handle: Long): Array<String>
+    /**
+     * Per-step estimates since the last call (Navigator::take_steps), flattened
+     * [STEP_DOUBLES] = 8 per step: `[t_ns (as double), lat_deg, lon_deg, sigma_east_m,
+     * sigma_north_m, corr_en, heading_rad, distance_m]`. lat..corr_en are NaN for a step
+     * before the start position is known; heading_rad is the step's walking direction
+     * (calibrated, clockwise from true north, [0, 2pi)); distance_m is the distance walked
+     * since the session start (sum of the calibrated step lengths). t_ns as a double is exact
+     * for 104 days of elapsedRealtimeNanos.
+     */
+    @JvmStatic external fun navTakeSteps(handle: Long): DoubleArray
+    /** End of input (Navigator::finish): releases a walk shorter than the bout gate; feed nothing after. */
+    @JvmStatic external fun navFinish(handle: Long)
     @JvmStatic external fun navClose(handle: Long)
 
     @JvmStatic external fun recOpen(path: String?, device: String?, flushIntervalNs: Long, fsync: Boolean): Long
@@ -68,22 +80,22 @@ object NativeBridge {
     /** DEM tile bounds: min lat, min lon, max lat, max lon (degrees). */
     @JvmStatic external fun demBounds(path: String?): DoubleArray
 
-    // ---- issue 29 (interface-29.md): routing, per-step estimates, finish, geodesic inverse ----
-    /** A loaded walkway graph + shortest-path router (owned by [NativeRouter]). */
+    /** Loads a walkway graph for [routeShortest] (route::Router); RuntimeException "path:line: reason" on a bad file. */
     @JvmStatic external fun routeOpen(graphPath: String?): Long
-    @JvmStatic external fun routeClose(handle: Long)
     /**
-     * Shortest walkway path: [length_m, from_snap_m, to_snap_m, lat0, lon0, lat1, lon1, ...];
-     * empty when no path exists; IllegalArgumentException for non-finite input.
+     * Shortest walkway path: `[length_m, from_snap_m, to_snap_m, lat0, lon0, lat1, lon1, ...]`,
+     * the polyline from the graph point nearest to `from` along walkways to the one nearest to
+     * `to` (both in the connected component closest to both ends); `length_m` along the graph,
+     * `*_snap_m` straight from the query points to the path's ends. Empty when no path exists
+     * (no walkway within 1 km of an end in a common component). IllegalArgumentException for
+     * non-finite or out-of-range input.
      */
     @JvmStatic external fun routeShortest(handle: Long, fromLat: Double, fromLon: Double, toLat: Double, toLon: Double): DoubleArray
-    /**
-     * Per-step estimates since the last call, 8 per step: t_ns (as double), lat, lon,
-     * sigma_east_m, sigma_north_m, corr_en, heading_rad, distance_m.
-     */
-    @JvmStatic external fun navTakeSteps(handle: Long): DoubleArray
-    /** Navigator::finish(): end of input (releases short walks, final estimate). */
-    @JvmStatic external fun navFinish(handle: Long)
-    /** Geodesic inverse on WGS84: [distance_m, initial_bearing_rad]. */
+    @JvmStatic external fun routeClose(handle: Long)
+
+    /** WGS84 geodesic (GeographicLib): `[distance_m, initial_bearing_rad]` (clockwise from true north, [0, 2pi)). */
     @JvmStatic external fun geoInverse(lat1: Double, lon1: Double, lat2: Double, lon2: Double): DoubleArray
+
+    /** Doubles per step in [navTakeSteps]. */
+    const val STEP_DOUBLES = 8
 }

@@ -50,10 +50,16 @@ class NativeNavigator(config: NavigatorConfig, seed: Long) : AutoCloseable, Samp
         (flat.indices step 4).map { ModeChange(flat[it].toLong(), flat[it + 1], flat[it + 2], flat[it + 3]) }
     }
 
-    /** Per-step estimates since the last call (issue 29), oldest first. */
-    fun takeSteps(): List<StepEstimate> = synchronized(h) { StepEstimate.parse(NativeBridge.navTakeSteps(h.get())) }
+    /** The steps since the last call, each with its estimate, heading and distance walked. */
+    fun takeSteps(): List<StepEstimate> = synchronized(h) {
+        val flat = NativeBridge.navTakeSteps(h.get())
+        val n = NativeBridge.STEP_DOUBLES
+        (flat.indices step n).map {
+            StepEstimate(flat[it].toLong(), flat[it + 1], flat[it + 2], flat[it + 3], flat[it + 4], flat[it + 5], flat[it + 6], flat[it + 7])
+        }
+    }
 
-    /** End of input: the core releases short walks and makes its final estimate. */
+    /** End of input: the core releases a short walk still held by the step detector. */
     fun finish() = synchronized(h) { NativeBridge.navFinish(h.get()) }
 
     override fun close() {
@@ -64,3 +70,15 @@ class NativeNavigator(config: NavigatorConfig, seed: Long) : AutoCloseable, Samp
 
 /** One hand-over of the fused estimate (core: fusion::ModeChange). */
 data class ModeChange(val tNs: Long, val from: String, val to: String, val reason: String)
+
+/**
+ * One step's estimate (core: fusion::StepEstimate). [latDeg] .. [corrEn] are NaN before the
+ * start position is known ([hasPosition] false). [headingRad] clockwise from true north;
+ * [distanceM] walked since the session start.
+ */
+data class StepEstimate(
+    val tNs: Long, val latDeg: Double, val lonDeg: Double, val sigmaEastM: Double, val sigmaNorthM: Double,
+    val corrEn: Double, val headingRad: Double, val distanceM: Double,
+) {
+    val hasPosition: Boolean get() = !latDeg.isNaN()
+}

@@ -38,6 +38,8 @@ import org.pdnav.app.region.RegionStore
 import org.pdnav.app.walk.GoTo
 import org.pdnav.app.walk.WalkState
 import org.pdnav.app.walk.WalkerWords
+import org.pdnav.app.walk.remainingM
+import org.pdnav.app.walk.sigmaM
 import java.io.File
 import java.util.Locale
 
@@ -333,7 +335,7 @@ class MainActivity : Activity() {
             getString(R.string.goto_text, g.place.name, WalkerWords.metres(g.straightM), Math.round(g.bearingDeg).toInt() % 360,
                 WalkerWords.compass(g.bearingDeg), along)
         }
-        mapController.showGoTo(g.place.latDeg, g.place.lonDeg, g.route?.points)
+        mapController.showGoTo(g.place.latDeg, g.place.lonDeg, g.route?.points?.map { doubleArrayOf(it.first, it.second) })
     }
 
     /** Which map the walk is on, or that it has left it (navigation goes on). */

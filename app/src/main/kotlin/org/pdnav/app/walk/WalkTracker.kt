@@ -1,6 +1,5 @@
 package org.pdnav.app.walk
 
-import org.pdnav.app.nav.Geo
 import org.pdnav.app.nav.NativeRouter
 import org.pdnav.app.nav.StepEstimate
 import org.pdnav.app.nav.WalkRoute
@@ -91,7 +90,7 @@ class WalkTracker(
     }
 
     private fun goTo(s: StepEstimate, t: Place, routeNow: Boolean): GoTo {
-        val inv = Geo.inverse(s.latDeg, s.lonDeg, t.latDeg, t.lonDeg)
+        val (distanceM, bearingRad) = NativeRouter.geoInverse(s.latDeg, s.lonDeg, t.latDeg, t.lonDeg)
         val route = if (routeNow && router != null) {
             routesComputed++
             router.shortest(s.latDeg, s.lonDeg, t.latDeg, t.lonDeg)
@@ -99,7 +98,7 @@ class WalkTracker(
             goTo?.route
         }
         val sigma = s.sigmaM
-        return GoTo(t, inv.distanceM, inv.bearingDeg, route, sigma, !(sigma < UNCERTAIN_RATIO * inv.distanceM), s.tNs)
+        return GoTo(t, distanceM, bearingDeg(bearingRad), route, sigma, !(sigma < UNCERTAIN_RATIO * distanceM), s.tNs)
     }
 
     override fun close() {
