@@ -298,6 +298,8 @@ def cmd_render(args):
         raise BasemapError("--detail-zoom must be within --min-zoom..--max-zoom+1")
     if args.detail_radius is not None and not args.detail_radius > 0:
         raise BasemapError("--detail-radius must be > 0 metres")
+    if not args.attribution.strip():
+        raise BasemapError("--attribution must not be empty (ODbL: the map must credit OpenStreetMap)")
     if args.metatile < 1 or args.metatile > 16:
         raise BasemapError("--metatile must be 1..16")
     try:
@@ -344,7 +346,7 @@ def cmd_render(args):
                                 f"z{args.min_zoom}-{args.detail_zoom - 1} whole area, "
                                 f"z{args.detail_zoom}-{args.max_zoom} within {detail.xmax:.0f} m "
                                 "of the centre"),
-                "attribution": ATTRIBUTION,
+                "attribution": args.attribution,
                 "bounds": ",".join(f"{v:.6f}" for v in box),
                 "center": f"{area.lon0:.6f},{area.lat0:.6f},{min(15, args.max_zoom)}",
                 "minzoom": str(args.min_zoom), "maxzoom": str(args.max_zoom),
@@ -449,6 +451,8 @@ def build_parser():
                    help="Mapnik image format of the tiles (default png256, as the OSM tile servers)")
     r.add_argument("--max-tiles", type=int, default=60000)
     r.add_argument("--name", default="pdnav basemap")
+    r.add_argument("--attribution", default=ATTRIBUTION,
+                   help="text to show on the map (MBTiles metadata 'attribution'; always written)")
     r.add_argument("--quiet", action="store_true")
     r.set_defaults(func=cmd_render)
     p = sub.add_parser("preview", help="PNG mosaic of zoom levels of an MBTiles")

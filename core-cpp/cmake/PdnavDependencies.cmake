@@ -33,6 +33,34 @@ if(NOT TARGET FastFloat::fast_float)
   target_include_directories(FastFloat::fast_float INTERFACE "${fast_float_SOURCE_DIR}/include")
 endif()
 
+# GeographicLib (MIT): the geodesic inverse problem (Karney 2013) behind geo::geodesic_inverse.
+# Host: Debian's libgeographiclib-dev; NDK: the same version built statically from its tag.
+if(NOT TARGET pdnav_geographiclib)
+  find_path(PDNAV_GEOGRAPHICLIB_INCLUDE GeographicLib/Geodesic.hpp)
+  find_library(PDNAV_GEOGRAPHICLIB_LIBRARY GeographicLib)
+  add_library(pdnav_geographiclib INTERFACE)
+  if(NOT ANDROID AND PDNAV_GEOGRAPHICLIB_INCLUDE AND PDNAV_GEOGRAPHICLIB_LIBRARY)
+    target_include_directories(pdnav_geographiclib SYSTEM INTERFACE "${PDNAV_GEOGRAPHICLIB_INCLUDE}")
+    target_link_libraries(pdnav_geographiclib INTERFACE "${PDNAV_GEOGRAPHICLIB_LIBRARY}")
+  elseif(NOT ANDROID)
+    message(FATAL_ERROR "pdnav: GeographicLib not found (tools/setup installs libgeographiclib-dev)")
+  else()
+    FetchContent_Declare(geographiclib
+      GIT_REPOSITORY https://github.com/geographiclib/geographiclib.git
+      GIT_TAG v2.1.2  # same version as Debian bookworm's libgeographiclib-dev
+      GIT_SHALLOW TRUE)
+    FetchContent_GetProperties(geographiclib)
+    if(NOT geographiclib_POPULATED)
+      FetchContent_Populate(geographiclib)
+    endif()
+    set(BUILD_SHARED_LIBS OFF)
+    set(BUILD_DOCUMENTATION OFF)
+    set(BUILD_MANPAGES OFF)
+    add_subdirectory("${geographiclib_SOURCE_DIR}" "${geographiclib_BINARY_DIR}" EXCLUDE_FROM_ALL)
+    target_link_libraries(pdnav_geographiclib INTERFACE GeographicLib::GeographicLib_STATIC)
+  endif()
+endif()
+
 if(NOT ANDROID)
   # Host-only tools (CLI, tests, benchmarks).
   find_package(CLI11 2.1 REQUIRED CONFIG)

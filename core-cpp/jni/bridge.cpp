@@ -10,8 +10,10 @@
 
 #include "jni_support.h"
 #include "pdnav/fusion/navigator.h"
+#include "pdnav/geo/geodesic.h"
 #include "pdnav/io/log_reader.h"
 #include "pdnav/io/log_writer.h"
+#include "pdnav/route/router.h"
 #include "pdnav/route/walk_graph.h"
 #include "pdnav/terrain/dem.h"
 #include "sample_codec.h"
@@ -22,6 +24,7 @@ namespace {
 using NavHandle = Handle<fusion::Navigator>;
 using RecHandle = Handle<io::LogWriter>;
 using ReaderHandle = Handle<io::LogReader>;
+using RouterHandle = Handle<route::Router>;
 
 constexpr const char* kBridgeClass = "org/pdnav/app/nav/NativeBridge";
 constexpr const char* kEstimateClass = "org/pdnav/app/nav/NavEstimate";
@@ -259,6 +262,46 @@ jobjectArray nav_mode_changes(JNIEnv* env, jclass, jlong handle) {
   });
 }
 
+jdoubleArray to_java(JNIEnv* env, const std::vector<double>& v);
+
+/// Per-step estimates since the last call, 8 doubles per step (layout in NativeBridge.kt):
+/// t_ns, lat, lon, sigma_east_m, sigma_north_m, corr_en, heading_rad, distance_m.
+/// lat/lon/sigmas/corr are NaN for a step before the start position is known.
+constexpr std::size_t kStepDoubles = 8;
+
+jdoubleArray nav_take_steps(JNIEnv* env, jclass, jlong handle) {
+  return guarded<jdoubleArray>(env, nullptr, [&] {
+    auto& h = from_handle<fusion::Navigator>(handle, "NativeNavigator");
+    std::vector<fusion::StepEstimate> steps;
+    {
+      const std::lock_guard<std::mutex> lock(h.mutex);
+      steps = h.object.take_steps();
+    }
+    const double nan = std::nan("");
+    std::vector<double> flat;
+    flat.reserve(steps.size() * kStepDoubles);
+    for (const fusion::StepEstimate& s : steps) {
+      const Estimate& e = s.estimate;
+      const bool ok = e.valid();
+      const double se = std::sqrt(std::max(0.0, e.cov_en_m2(0, 0)));
+      const double sn = std::sqrt(std::max(0.0, e.cov_en_m2(1, 1)));
+      const double corr = se > 0.0 && sn > 0.0 ? e.cov_en_m2(0, 1) / (se * sn) : 0.0;
+      flat.insert(flat.end(), {static_cast<double>(e.t_ns), ok ? e.position.lat_deg() : nan,
+                               ok ? e.position.lon_deg() : nan, ok ? se : nan, ok ? sn : nan,
+                               ok ? corr : nan, s.heading_rad, s.distance_m});
+    }
+    return to_java(env, flat);
+  });
+}
+
+void nav_finish(JNIEnv* env, jclass, jlong handle) {
+  guarded_void(env, [&] {
+    auto& h = from_handle<fusion::Navigator>(handle, "NativeNavigator");
+    const std::lock_guard<std::mutex> lock(h.mutex);
+    h.object.finish();
+  });
+}
+
 void nav_close(JNIEnv* env, jclass, jlong handle) {
   guarded_void(env, [&] {
     auto* h = &from_handle<fusion::Navigator>(handle, "NativeNavigator");
@@ -428,6 +471,54 @@ jdoubleArray dem_bounds(JNIEnv* env, jclass, jstring path) {
   });
 }
 
+// ---- router (route::Router on a loaded walkway graph) ------------------------------------
+
+jlong route_open(JNIEnv* env, jclass, jstring path) {
+  return guarded<jlong>(env, 0, [&] {
+    auto graph = std::make_shared<const route::WalkGraph>(route::WalkGraph::load(to_string(env, path, "graphPath")));
+    return to_handle(new RouterHandle(route::RouterOptions{}, std::move(graph)));
+  });
+}
+
+/// [length_m, from_snap_m, to_snap_m, lat0, lon0, lat1, lon1, ...]; empty when no path.
+jdoubleArray route_shortest(JNIEnv* env, jclass, jlong handle, jdouble from_lat, jdouble from_lon,
+                            jdouble to_lat, jdouble to_lon) {
+  return guarded<jdoubleArray>(env, nullptr, [&] {
+    auto& h = from_handle<route::Router>(handle, "NativeRouter");
+    route::RoutePath p;
+    {
+      const std::lock_guard<std::mutex> lock(h.mutex);
+      p = h.object.shortest_geodetic(from_lat, from_lon, to_lat, to_lon);  // invalid_argument on NaN
+    }
+    std::vector<double> out;
+    if (!p.found) return to_java(env, out);
+    out.reserve(3 + 2 * p.polyline_en_m.size());
+    out.insert(out.end(), {p.length_m, p.from_snap_m, p.to_snap_m});
+    for (const auto& q : p.polyline_en_m) {
+      const geo::Geodetic g = h.object.graph().frame().to_geodetic(geo::Enu(q.x(), q.y(), 0.0));
+      out.push_back(g.lat_deg());
+      out.push_back(g.lon_deg());
+    }
+    return to_java(env, out);
+  });
+}
+
+void route_close(JNIEnv* env, jclass, jlong handle) {
+  guarded_void(env, [&] {
+    auto* h = &from_handle<route::Router>(handle, "NativeRouter");
+    { const std::lock_guard<std::mutex> lock(h->mutex); }
+    delete h;
+  });
+}
+
+/// [distance_m, initial_bearing_rad] on the WGS84 ellipsoid (GeographicLib).
+jdoubleArray geo_inverse(JNIEnv* env, jclass, jdouble lat1, jdouble lon1, jdouble lat2, jdouble lon2) {
+  return guarded<jdoubleArray>(env, nullptr, [&] {
+    const geo::GeodesicInverse r = geo::geodesic_inverse(lat1, lon1, lat2, lon2);
+    return to_java(env, {r.distance_m, r.initial_bearing_rad});
+  });
+}
+
 #define PDNAV_BATCH_SIG "I[I[J[J[D[Ljava/lang/String;[B"
 
 const JNINativeMethod kMethods[] = {
@@ -441,6 +532,8 @@ const JNINativeMethod kMethods[] = {
     {const_cast<char*>("navOutput"), const_cast<char*>("(JI)Lorg/pdnav/app/nav/NavOutput;"), reinterpret_cast<void*>(&nav_output)},
     {const_cast<char*>("navIgnored"), const_cast<char*>("(J)[Ljava/lang/String;"), reinterpret_cast<void*>(&nav_ignored)},
     {const_cast<char*>("navModeChanges"), const_cast<char*>("(J)[Ljava/lang/String;"), reinterpret_cast<void*>(&nav_mode_changes)},
+    {const_cast<char*>("navTakeSteps"), const_cast<char*>("(J)[D"), reinterpret_cast<void*>(&nav_take_steps)},
+    {const_cast<char*>("navFinish"), const_cast<char*>("(J)V"), reinterpret_cast<void*>(&nav_finish)},
     {const_cast<char*>("navClose"), const_cast<char*>("(J)V"), reinterpret_cast<void*>(&nav_close)},
     {const_cast<char*>("recOpen"), const_cast<char*>("(Ljava/lang/String;Ljava/lang/String;JZ)J"), reinterpret_cast<void*>(&rec_open)},
     {const_cast<char*>("recWrite"), const_cast<char*>("(J" PDNAV_BATCH_SIG ")V"), reinterpret_cast<void*>(&rec_write)},
@@ -454,6 +547,10 @@ const JNINativeMethod kMethods[] = {
     {const_cast<char*>("readerClose"), const_cast<char*>("(J)V"), reinterpret_cast<void*>(&reader_close)},
     {const_cast<char*>("graphPolylines"), const_cast<char*>("(Ljava/lang/String;)[D"), reinterpret_cast<void*>(&graph_polylines)},
     {const_cast<char*>("demBounds"), const_cast<char*>("(Ljava/lang/String;)[D"), reinterpret_cast<void*>(&dem_bounds)},
+    {const_cast<char*>("routeOpen"), const_cast<char*>("(Ljava/lang/String;)J"), reinterpret_cast<void*>(&route_open)},
+    {const_cast<char*>("routeShortest"), const_cast<char*>("(JDDDD)[D"), reinterpret_cast<void*>(&route_shortest)},
+    {const_cast<char*>("routeClose"), const_cast<char*>("(J)V"), reinterpret_cast<void*>(&route_close)},
+    {const_cast<char*>("geoInverse"), const_cast<char*>("(DDDD)[D"), reinterpret_cast<void*>(&geo_inverse)},
 };
 
 }  // namespace

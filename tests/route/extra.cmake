@@ -25,3 +25,18 @@ set_tests_properties(route_eval_osm_cached PROPERTIES LABELS "route;cli"
 add_test(NAME route_eval_missing_graph
          COMMAND "$<TARGET_FILE:pdnav>" eval-route --graph "${PROJECT_BINARY_DIR}/no-such.graph")
 set_tests_properties(route_eval_missing_graph PROPERTIES LABELS "route;cli" WILL_FAIL TRUE)
+
+# issue 29: `pdnav route` (route::Router, A*) against an independent scipy Dijkstra on the same
+# Andorra graph: 60 fixed-seed query pairs, lengths and snaps equal within 0.1 m, no-path agreed.
+add_test(NAME route_shortest_vs_scipy
+         COMMAND /usr/bin/python3 "${CMAKE_CURRENT_LIST_DIR}/check_shortest_path.py"
+                 --pdnav "$<TARGET_FILE:pdnav>" --graph "${_route_graph}" --pairs 60 --seed 1 --tol 0.1)
+set_tests_properties(route_shortest_vs_scipy PROPERTIES LABELS "route;cli" FIXTURES_REQUIRED route_andorra_graph
+                     TIMEOUT 300)
+add_test(NAME route_cli_bad_point
+         COMMAND "$<TARGET_FILE:pdnav>" route --graph "${_route_graph}" --from 42.5,nan --to 42.5,1.5)
+set_tests_properties(route_cli_bad_point PROPERTIES LABELS "route;cli" FIXTURES_REQUIRED route_andorra_graph
+                     PASS_REGULAR_EXPRESSION "--from: expected LAT,LON in degrees")
+add_test(NAME route_cli_missing_graph
+         COMMAND "$<TARGET_FILE:pdnav>" route --graph "${PROJECT_BINARY_DIR}/no-such.graph" --from 42.5,1.5 --to 42.5,1.5)
+set_tests_properties(route_cli_missing_graph PROPERTIES LABELS "route;cli" WILL_FAIL TRUE)

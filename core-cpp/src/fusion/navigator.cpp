@@ -111,7 +111,8 @@ struct Navigator::Impl {
   std::int64_t steps = 0;
   std::int64_t first_utc_ms = kMissingInt;  // wall clock of the session (WMM date)
   geo::Geodetic start_position;
-  std::vector<Estimate> step_estimates;   // the estimate after each step, at its own time (take_step_estimates)
+  std::vector<StepEstimate> step_estimates;  // after each step, at its own time (take_steps)
+  double walked_m = 0.0;                  // sum of the calibrated step lengths
   double pending_start_lat = kNaN, pending_start_lon = kNaN, pending_start_sigma = kNaN;
 
   // --- the fused estimate (mode kAuto) ---
@@ -271,8 +272,9 @@ struct Navigator::Impl {
         if (terrain) terrain->feed(s);
         if (route) route->feed(s);
       }
-      Estimate e = choose();
-      if (e.valid()) step_estimates.push_back(std::move(e));
+      const PdrStep c = calibrated(s);
+      walked_m += c.length_m;
+      step_estimates.push_back(StepEstimate{choose(), c.heading_rad, walked_m});
       // a caller that never takes them (the app) must not grow memory: the newest are kept
       if (step_estimates.size() > kStepEstimatesKept) step_estimates.erase(step_estimates.begin());
     }
@@ -752,7 +754,14 @@ void Navigator::finish() {
   impl_->drain_pdr();
 }
 
-std::vector<Estimate> Navigator::take_step_estimates() { return std::exchange(impl_->step_estimates, {}); }
+std::vector<Estimate> Navigator::take_step_estimates() {
+  std::vector<Estimate> out;
+  for (StepEstimate& s : std::exchange(impl_->step_estimates, {}))
+    if (s.estimate.valid()) out.push_back(std::move(s.estimate));
+  return out;
+}
+
+std::vector<StepEstimate> Navigator::take_steps() { return std::exchange(impl_->step_estimates, {}); }
 
 void Navigator::set_start(double lat_deg, double lon_deg, double sigma_m, TimeNs t_ns) {
   impl_->start(lat_deg, lon_deg, sigma_m, t_ns);

@@ -141,6 +141,13 @@ struct NavigatorOutput {
   geo::Declination declination;
 };
 
+/// One step as a walker's screen shows it (the app's per-step estimates, JNI navTakeSteps).
+struct StepEstimate {
+  Estimate estimate;            // after the step, at its time (status kNotInitialized before a start)
+  double heading_rad = 0.0;     // the step's walking direction (calibrated), clockwise from true north
+  double distance_m = 0.0;      // walked since the session start: sum of the (calibrated) step lengths
+};
+
 class Navigator {
  public:
   Navigator(const NavigatorConfig& config, std::uint64_t seed);
@@ -158,6 +165,9 @@ class Navigator {
   /// steps can be released by one sample); the replay writes one track row per step. The
   /// newest 256 are held for a caller that never takes them.
   std::vector<Estimate> take_step_estimates();
+  /// Every step since the last call (of this or take_step_estimates(): one queue), with its
+  /// heading and the distance walked; steps before a start position carry an invalid estimate.
+  std::vector<StepEstimate> take_steps();
   /// Declare or reset the start position (e.g. user long-press on the map).
   void set_start(double lat_deg, double lon_deg, double sigma_m, TimeNs t_ns);
 
