@@ -46,6 +46,15 @@ class MapController(context: Context, val map: MapView) {
     private val density = context.resources.displayMetrics.density
     var showParticles = true
 
+    /** The tester's layers (each engine's ring, the particle cloud): shown with the details. */
+    var testerLayers: Boolean
+        get() = cloud.isEnabled
+        set(v) {
+            cloud.isEnabled = v
+            engineDots.isEnabled = v
+            map.invalidate()
+        }
+
     /** Follow the estimate (re-centre on every output) or leave the map where the user put it. */
     var follow = true
 
@@ -59,7 +68,7 @@ class MapController(context: Context, val map: MapView) {
         cfg.osmdroidTileCache = File(context.cacheDir, "osmdroid-tiles")
         map.setUseDataConnection(false)  // offline only
         map.setMultiTouchControls(true)
-        map.controller.setZoom(17.0)
+        map.controller.setZoom(DEFAULT_ZOOM)
         marker.setAnchor(Marker.ANCHOR_CENTER, Marker.ANCHOR_CENTER)  // the icon's centre is the position
         marker.icon = android.graphics.drawable.BitmapDrawable(context.resources, arrowBitmap(Color.rgb(30, 111, 217), density))
         marker.isFlat = true  // the arrow keeps its bearing when the map rotates
@@ -94,6 +103,8 @@ class MapController(context: Context, val map: MapView) {
         map.overlays.add(marker)
         marker.isEnabled = false
         ellipse.isEnabled = false
+        cloud.isEnabled = false
+        engineDots.isEnabled = false
         fixMarker.isEnabled = false
         fixCircle.isEnabled = false
         map.setOnTouchListener { _, ev ->
@@ -209,7 +220,7 @@ class MapController(context: Context, val map: MapView) {
         // offline tiles only: never zoom past the deepest zoom the file has (blank grid there)
         MbtilesBounds.maxZoom(file)?.let { z ->
             map.maxZoomLevel = z.toDouble()
-            if (map.zoomLevelDouble > z) map.controller.setZoom(z.toDouble())
+            map.controller.setZoom(minOf(DEFAULT_ZOOM, z.toDouble()))
         }
         return true
     }
@@ -324,6 +335,8 @@ class MapController(context: Context, val map: MapView) {
             c.drawCircle(size / 2f, size / 2f, size / 2f - 2 * density, Paint(Paint.ANTI_ALIAS_FLAG).apply { this.color = color })
             return b
         }
+
+        const val DEFAULT_ZOOM = 17.0
 
         /** 95 % content of a 2D Gaussian: k = sqrt(-2 ln 0.05). */
         const val K95 = 2.4477

@@ -566,7 +566,9 @@ class MainActivity : Activity() {
 
     /** Shows or hides the tester's details (one tap on the walker's panel). */
     fun toggleDetails() {
-        detailsPanel.visibility = if (detailsPanel.visibility == View.VISIBLE) View.GONE else View.VISIBLE
+        val show = detailsPanel.visibility != View.VISIBLE
+        detailsPanel.visibility = if (show) View.VISIBLE else View.GONE
+        mapController.testerLayers = show  // each engine's ring and the particle cloud
     }
 
     /** Live state: duration, size, rows per line type, GNSS epochs, magnetometer accuracy, satellites. */
@@ -727,6 +729,7 @@ class MainActivity : Activity() {
         navigateButton = Views.button(this, R.id.button_navigate, getString(R.string.action_navigate)) { toggleNavigation() }
         recordButton = Views.button(this, R.id.button_record, getString(R.string.action_record)) { toggleRecording() }
         checkpointButton = Views.button(this, R.id.button_checkpoint, getString(R.string.action_checkpoint)) { askCheckpoint() }
+        detailsPanel.addView(checkpointButton, LinearLayout.LayoutParams(-2, -2))  // a tester's tool: with the details
         followButton = Views.button(this, R.id.button_follow, getString(R.string.action_follow_on)) {
             mapController.follow = !mapController.follow
             updateFollow()
@@ -751,8 +754,8 @@ class MainActivity : Activity() {
         val bottom = LinearLayout(this).apply {
             orientation = LinearLayout.VERTICAL
             addView(attribution, LinearLayout.LayoutParams(-2, -2))
-            addView(Views.row(context, navigateButton, recordButton, savePlaceButton, checkpointButton))
-            addView(Views.row(context, placesButton, followButton, satButton, settingsButton, sessionsButton))
+            addView(Views.row(context, navigateButton, recordButton, savePlaceButton, placesButton))
+            addView(Views.row(context, followButton, satButton, settingsButton, sessionsButton))
         }
         root.addView(bottom, FrameLayout.LayoutParams(-1, -2, Gravity.BOTTOM))
 
