@@ -313,9 +313,10 @@ class WalkerScreensRoboTest {
 
         // places: kept per region; the screen's Go to returns to the map with the place
         val store = PlaceStore(app.filesDir, region.name)
-        store.add(Place("Start 09:41", startLat, startLon, Place.START, 1_000L))
-        store.add(hut.copy(createdMs = 2_000L))
-        store.add(Place("Checkpoint 09:50", 42.5230, 1.5720, Place.CHECKPOINT, 3_000L))
+        val t0 = 1_796_290_860_000L  // 2026-12-03 09:41 UTC
+        store.add(Place("Start 09:41", startLat, startLon, Place.START, t0))
+        store.add(hut.copy(createdMs = t0 + 240_000L))
+        store.add(Place("Checkpoint 09:50", 42.5230, 1.5720, Place.CHECKPOINT, t0 + 540_000L))
         val places = Robolectric.buildActivity(PlacesActivity::class.java,
             android.content.Intent(app, PlacesActivity::class.java).putExtra(PlacesActivity.EXTRA_REGION, region.name)).setup().get()
         idle()

@@ -35,7 +35,7 @@ class PlacesActivity : Activity() {
             setPadding(p, p, p, p)
         }
         val scroll = ScrollView(this).apply { addView(rows) }
-        Views.applySystemBarInsets(scroll, rows, rows)
+        Views.applySystemBarInsets(scroll, scroll, scroll)  // the list keeps its own padding
         setContentView(scroll)
         title = if (region != null) getString(R.string.places_header, region) else getString(R.string.places_header_none)
     }
@@ -50,7 +50,6 @@ class PlacesActivity : Activity() {
 
     private fun refresh() {
         rows.removeAllViews()
-        rows.addView(Views.label(this, title))
         val places = shown()
         if (places.isEmpty()) {
             rows.addView(TextView(this).apply { id = R.id.places_empty; text = getString(R.string.places_empty) },

@@ -52,7 +52,7 @@ class RegionsActivity : Activity() {
             addView(rows, LinearLayout.LayoutParams(-1, -2))
         }
         val scroll = ScrollView(this).apply { addView(form) }
-        Views.applySystemBarInsets(scroll, form, form)
+        Views.applySystemBarInsets(scroll, scroll, scroll)  // the form keeps its own padding
         setContentView(scroll)
         refresh()
         // "open with": a region file handed over by another app
