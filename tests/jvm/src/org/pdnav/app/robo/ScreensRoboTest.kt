@@ -372,7 +372,7 @@ class ScreensRoboTest {
         val spanned = legend.text as android.text.Spanned
         for (c in listOf(1, 3, 5, 6)) {
             val name = SkyPlotView.constellationName(c)
-            val at = legend.text.indexOf(" $name") - 1
+            val at = legend.text.indexOf("●\u00A0$name")
             assertTrue(at >= 0, "legend names $name: ${legend.text}")
             val spans = spanned.getSpans(at, at + 1, android.text.style.ForegroundColorSpan::class.java)
             assertEquals(SkyPlotView.constellationColor(c), spans.single().foregroundColor, "legend dot of $name in its colour")

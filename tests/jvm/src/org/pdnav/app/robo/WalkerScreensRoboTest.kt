@@ -151,7 +151,15 @@ class WalkerScreensRoboTest {
     @Test
     fun aReplayPicksItsRegionAndTheWalkerReadsWords() {
         grantAll()
-        val region = installRegion()
+        // the walker opens the region file with the app ("open with": a VIEW intent)
+        val pack = RegionFixture.build("Engolasters", "--center", "${BasemapFixture.CENTER_LAT},${BasemapFixture.CENTER_LON}",
+            "--radius", "${BasemapFixture.RADIUS_M}")
+        val regions = Robolectric.buildActivity(RegionsActivity::class.java,
+            android.content.Intent(android.content.Intent.ACTION_VIEW, android.net.Uri.fromFile(pack))).setup().get()
+        regions.importThread?.join(60_000)
+        idle()
+        assertTrue(text(regions, R.id.regions_status).startsWith("Installed Engolasters ("), text(regions, R.id.regions_status))
+        val region = assertNotNull(RegionStore(app.filesDir).find("Engolasters"), "installed")
         assertTrue(region.attribution.contains("© OpenStreetMap contributors"), "manifest attribution: ${region.attribution}")
         val (_, log) = BasemapFixture.simulatedWalk()
         settings.engine = "auto"
@@ -205,8 +213,6 @@ class WalkerScreensRoboTest {
         BasemapFixture.assertTextNotClipped(decor, details, "details")
 
         // the regions screen lists it with its area and size
-        val regions = Robolectric.buildActivity(RegionsActivity::class.java).setup().get()
-        idle()
         val rp = BasemapFixture.snapshot(regions.window.decorView)
         BasemapFixture.save(rp, "regions")
         val listed = visibleText(regions.window.decorView)

@@ -141,9 +141,9 @@ class SkyPlotView(context: Context) : View(context) {
                 val at = b.length
                 b.append("●")
                 b.setSpan(android.text.style.ForegroundColorSpan(constellationColor(c)), at, at + 1, android.text.Spanned.SPAN_EXCLUSIVE_EXCLUSIVE)
-                b.append(" ").append(constellationName(c))
+                b.append("\u00A0").append(constellationName(c))  // the dot stays with its name
             }
-            b.append("  (filled: used in the fix)")
+            b.append("  (filled: used\u00A0in\u00A0the\u00A0fix)")
             return b
         }
 
