@@ -188,7 +188,7 @@ class WalkerScreensRoboTest {
         val (pic, _) = pictureWithTiles(decor, map)
         BasemapFixture.save(pic, "main-walker")
         val attribution = activity.findViewById<TextView>(R.id.map_attribution)
-        assertEquals(View.VISIBLE, attribution.visibility)
+        assertEquals(View.VISIBLE, attribution.visibility, "attribution shown")
         assertTrue(attribution.text.startsWith("© OpenStreetMap contributors"), "attribution: ${attribution.text}")
         assertTrue(activity.map.graphEdgeCount > 10, "the region's walkway graph is drawn (${activity.map.graphEdgeCount} edges)")
         assertTrue(Regex("±\\d+ m, (very good|good|fair|poor|very poor)").matches(text(activity, R.id.walker_position)), text(activity, R.id.walker_position))
@@ -307,7 +307,7 @@ class WalkerScreensRoboTest {
         val near3 = Place("Car park", s.latDeg + 3.0 / 111_195.0, s.lonDeg, Place.SAVED, 2L)
         val u = replay(log, near3).walks.last().goTo!!
         assertTrue(u.sigmaM > u.straightM, "sigma ${u.sigmaM} m > distance ${u.straightM} m")
-        assertTrue(u.uncertain)
+        assertTrue(u.uncertain, "sigma ${u.sigmaM} m >= half of ${u.straightM} m: flagged uncertain")
         activity.showWalk(r.walks.last().copy(goTo = u))
         idle()
         val up = BasemapFixture.snapshot(decor)
