@@ -119,6 +119,9 @@ def osm_extent_lonlat(path):
     if ds is None or ds.GetLayerByName("lines") is None or ds.GetLayerByName("multipolygons") is None:
         raise BasemapError(f"{path}: not an OSM extract (needs the GDAL OSM driver's lines and "
                            "multipolygons layers)")
+    def plausible(e):  # an .osm file without <bounds> gives an undefined extent (GDAL 3.6)
+        return -180 <= e[0] < e[1] <= 180 and -90 <= e[2] < e[3] <= 90
+
     ext = None
     for name in ("lines", "multipolygons", "points"):
         lyr = ds.GetLayerByName(name)
@@ -126,8 +129,21 @@ def osm_extent_lonlat(path):
             e = lyr.GetExtent(force=1)  # (minx, maxx, miny, maxy), EPSG:4326 lon/lat
         except RuntimeError:
             continue
+        if not plausible(e):
+            continue
         ext = e if ext is None else (min(ext[0], e[0]), max(ext[1], e[1]),
                                      min(ext[2], e[2]), max(ext[3], e[3]))
+    if ext is None:  # no header bounds: the envelope of the features themselves
+        ds = gdal.OpenEx(path, gdal.OF_VECTOR)
+        for name in ("points", "lines", "multipolygons"):
+            lyr = ds.GetLayerByName(name)
+            for feat in lyr:
+                g = feat.GetGeometryRef()
+                if g is None or g.IsEmpty():
+                    continue
+                e = g.GetEnvelope()
+                ext = e if ext is None else (min(ext[0], e[0]), max(ext[1], e[1]),
+                                             min(ext[2], e[2]), max(ext[3], e[3]))
     if ext is None:
         raise BasemapError(f"{path}: the OSM extract holds no features")
     return ext[0], ext[2], ext[1], ext[3]

@@ -21,7 +21,7 @@ import datetime
 import hashlib
 import json
 import os
-import sqlite3
+import re
 import sys
 import tempfile
 import time
@@ -137,8 +137,10 @@ def cmd_build(args):
     if not out.endswith(".pdnav-region"):
         raise RegionError(f"{out}: the output name must end in .pdnav-region")
     name = args.name or os.path.basename(out)[:-len(".pdnav-region")]
-    if not name or "/" in name or name in (".", ".."):
-        raise RegionError(f"bad region name '{name}'")
+    # the app installs into filesDir/regions/<name>/: a plain folder name
+    if not re.fullmatch(r"[\w .-]{1,64}", name) or name.startswith(".") or name != name.strip():
+        raise RegionError(f"bad region name '{name}': use 1-64 letters, digits, space, '.', '-', '_' "
+                          "(not starting with '.')")
 
     # the area once, with the DEM tools' own parser (same checks and frame for all three files)
     area_ns = pdnav_dem.build_parser().parse_args(["tile", "-", "-o", "-"] + area_argv)

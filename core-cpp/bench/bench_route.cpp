@@ -2,11 +2,13 @@
 // A 10 m street grid (2 km square) keeps the route count steady: every route goes straight
 // through the crossings (the 90 deg branches exceed the shallow limit) and merging keeps
 // the set from growing. Items/s = PdrStep updates per second; `routes` = mean live routes.
+#include <cmath>
 #include <memory>
 
 #include <benchmark/benchmark.h>
 
 #include "pdnav/route/route_engine.h"
+#include "pdnav/route/router.h"
 #include "pdnav/route/walk_graph.h"
 
 namespace {
@@ -139,5 +141,36 @@ void BM_RouteTurn(benchmark::State& state) {
   report(state, n, routes_sum);
 }
 BENCHMARK(BM_RouteTurn)->Arg(10)->Arg(100)->Arg(1000);
+
+// Shortest path ("Go to", route::Router) on the same 2 km grid (40 401 vertices, 80 400 edges):
+// one query per iteration from near the centre to a point `arg` metres away diagonally
+// (both snapped from 3 m off a street); `settled` = nodes A* settled per query.
+void BM_RouterShortest(benchmark::State& state) {
+  const auto g = grid_graph();
+  const pdnav::route::Router router(pdnav::route::RouterOptions{}, g);
+  const double d = static_cast<double>(state.range(0)) / std::sqrt(2.0);
+  const Eigen::Vector2d from(1003.0, 1001.5), to(1003.0 - d, 1001.5 - d);
+  double settled = 0.0;
+  std::int64_t n = 0;
+  for (auto _ : state) {
+    const pdnav::route::RoutePath p = router.shortest(from, to);
+    benchmark::DoNotOptimize(p.length_m);
+    settled += static_cast<double>(p.settled);
+    ++n;
+  }
+  state.SetItemsProcessed(n);
+  state.counters["settled"] = n ? settled / static_cast<double>(n) : 0.0;
+}
+BENCHMARK(BM_RouterShortest)->Arg(100)->Arg(500)->Arg(1400)->Unit(benchmark::kMicrosecond);
+
+// Building the router (connected components) on the grid.
+void BM_RouterBuild(benchmark::State& state) {
+  const auto g = grid_graph();
+  for (auto _ : state) {
+    const pdnav::route::Router router(pdnav::route::RouterOptions{}, g);
+    benchmark::DoNotOptimize(router.component_count());
+  }
+}
+BENCHMARK(BM_RouterBuild)->Unit(benchmark::kMillisecond);
 
 }  // namespace

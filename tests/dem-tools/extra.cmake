@@ -11,3 +11,9 @@ add_test(NAME dem_tools.basemap
           "${PDNAV_SHARED_DATA_DIR}" "${PROJECT_BINARY_DIR}/test-scratch/dem-tools-basemap")
 set_tests_properties(dem_tools.basemap PROPERTIES LABELS "dem-tools" TIMEOUT 600)
 # ---- basemap (end) ----
+# ---- region pack (dem-tools/pdnav_region.py), issue 29 (begin) ----
+add_test(NAME dem_tools.region
+  COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/dem-tools/test_region.py"
+          "${PDNAV_SHARED_DATA_DIR}" "${PROJECT_BINARY_DIR}/test-scratch/dem-tools-region" "$<TARGET_FILE:pdnav>")
+set_tests_properties(dem_tools.region PROPERTIES LABELS "dem-tools" TIMEOUT 300)
+# ---- region pack (end) ----

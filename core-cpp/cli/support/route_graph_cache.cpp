@@ -22,9 +22,10 @@ std::string shell_quote(const std::string& s) {
 }  // namespace
 
 std::string default_graph_tool() {
-  // This file is core-cpp/cli/support/route_graph_cache.cpp in the source tree.
-  const std::filesystem::path here(__FILE__);
-  return (here.parent_path().parent_path().parent_path().parent_path() / "dem-tools" / "pdnav_graph.py").string();
+  // The source tree's dem-tools, as an absolute path from CMake: __FILE__ is relative to the
+  // build folder when ccache rewrites paths (CCACHE_BASEDIR), which broke the default when
+  // pdnav ran from another folder (ctest runs tests from build/dev/tests).
+  return (std::filesystem::path(PDNAV_SOURCE_DIR) / "dem-tools" / "pdnav_graph.py").string();
 }
 
 std::string build_graph_cached(const std::string& osm_path, const std::string& cache_dir,

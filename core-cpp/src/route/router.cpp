@@ -11,6 +11,7 @@ namespace pdnav::route {
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kGridSearchMax_m = 1.0e4;  // WalkGraph::segments_near caps its radius here
+constexpr double kFirstSearch_m = 50.0;     // first snap search radius (grows x4 up to max_snap_m)
 }  // namespace
 
 Router::Router(const RouterOptions& options, std::shared_ptr<const WalkGraph> graph)
@@ -41,7 +42,7 @@ Router::Router(const RouterOptions& options, std::shared_ptr<const WalkGraph> gr
   }
 }
 
-std::vector<GraphPoint> Router::nearest_per_component(const Eigen::Vector2d& p) const {
+std::vector<GraphPoint> Router::nearest_per_component(const Eigen::Vector2d& p, double radius_m) const {
   std::vector<GraphPoint> best(component_size_.size());
   for (auto& b : best) b.snap_m = kInf;
   auto consider = [&](std::int32_t even) {
@@ -49,7 +50,7 @@ std::vector<GraphPoint> Router::nearest_per_component(const Eigen::Vector2d& p) 
     Eigen::Vector2d c;
     const double t = WalkGraph::project(s, p, &c);
     const double d = (c - p).norm();
-    if (!(d <= opt_.max_snap_m)) return;
+    if (!(d <= radius_m)) return;
     GraphPoint& b = best[component_[s.from]];
     if (d < b.snap_m) {  // pieces come in increasing id: ties keep the lower id (deterministic)
       b.segment = even;
@@ -59,8 +60,8 @@ std::vector<GraphPoint> Router::nearest_per_component(const Eigen::Vector2d& p) 
       b.component = component_[s.from];
     }
   };
-  if (opt_.max_snap_m <= kGridSearchMax_m) {
-    for (const std::int32_t s : graph_->segments_near(p, opt_.max_snap_m)) {
+  if (radius_m <= kGridSearchMax_m) {
+    for (const std::int32_t s : graph_->segments_near(p, radius_m)) {
       if ((s & 1) == 0) consider(s);
     }
   } else {
@@ -89,19 +90,28 @@ RoutePath Router::shortest(const Eigen::Vector2d& from_en_m, const Eigen::Vector
     throw std::invalid_argument("route: non-finite query point");
   }
   RoutePath out;
-  const std::vector<GraphPoint> fa = nearest_per_component(from_en_m);
-  const std::vector<GraphPoint> fb = nearest_per_component(to_en_m);
+  // The component with the smallest snap sum, searched in growing radii: at radius r every
+  // component with both snaps <= r is found exactly, and any other has a sum > r, so a best
+  // sum <= r is final (the last round, r = max_snap_m, is the exhaustive one).
+  std::vector<GraphPoint> fa, fb;
   std::int32_t comp = -1;
-  double best_snaps = kInf;
   bool any_from = false, any_to = false;
-  for (std::size_t c = 0; c < fa.size(); ++c) {
-    any_from = any_from || std::isfinite(fa[c].snap_m);
-    any_to = any_to || std::isfinite(fb[c].snap_m);
-    const double sum = fa[c].snap_m + fb[c].snap_m;
-    if (sum < best_snaps) {
-      best_snaps = sum;
-      comp = static_cast<std::int32_t>(c);
+  for (double r = std::min(opt_.max_snap_m, kFirstSearch_m);; r = std::min(opt_.max_snap_m, 4.0 * r)) {
+    fa = nearest_per_component(from_en_m, r);
+    fb = nearest_per_component(to_en_m, r);
+    comp = -1;
+    double best_snaps = kInf;
+    any_from = any_to = false;
+    for (std::size_t c = 0; c < fa.size(); ++c) {
+      any_from = any_from || std::isfinite(fa[c].snap_m);
+      any_to = any_to || std::isfinite(fb[c].snap_m);
+      const double sum = fa[c].snap_m + fb[c].snap_m;
+      if (sum < best_snaps) {
+        best_snaps = sum;
+        comp = static_cast<std::int32_t>(c);
+      }
     }
+    if (best_snaps <= r || r >= opt_.max_snap_m) break;
   }
   const std::string within = " within " + std::to_string(static_cast<long long>(std::lround(opt_.max_snap_m))) + " m";
   if (comp < 0) {

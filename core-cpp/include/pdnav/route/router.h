@@ -66,9 +66,9 @@ class Router {
   const RouterOptions& options() const { return opt_; }
 
  private:
-  /// Nearest point of each component within max_snap_m of p (index = component; snap_m =
+  /// Nearest point of each component within radius_m of p (index = component; snap_m =
   /// +inf where none).
-  std::vector<GraphPoint> nearest_per_component(const Eigen::Vector2d& p) const;
+  std::vector<GraphPoint> nearest_per_component(const Eigen::Vector2d& p, double radius_m) const;
 
   RouterOptions opt_;
   std::shared_ptr<const WalkGraph> graph_;
