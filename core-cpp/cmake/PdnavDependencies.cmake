@@ -33,6 +33,18 @@ if(NOT TARGET FastFloat::fast_float)
   target_include_directories(FastFloat::fast_float INTERFACE "${fast_float_SOURCE_DIR}/include")
 endif()
 
+if(NOT ANDROID)
+  # Host-only tools (CLI, tests, benchmarks).
+  find_package(CLI11 2.1 REQUIRED CONFIG)
+  find_package(nlohmann_json 3.11 REQUIRED CONFIG)
+  if(PDNAV_BUILD_TESTS)
+    find_package(GTest 1.12 REQUIRED CONFIG)
+  endif()
+  if(PDNAV_BUILD_BENCHMARKS)
+    find_package(benchmark 1.7 REQUIRED CONFIG)
+  endif()
+endif()
+
 # GeographicLib (MIT): the geodesic inverse problem (Karney 2013) behind geo::geodesic_inverse.
 # Host: Debian's libgeographiclib-dev; NDK: the same version built statically from its tag
 # (PDNAV_GEOGRAPHICLIB_FROM_SOURCE=ON tries that path on the host; with no network, point
@@ -70,17 +82,5 @@ if(NOT TARGET pdnav_geographiclib)
     add_subdirectory("${geographiclib_SOURCE_DIR}" "${geographiclib_BINARY_DIR}" EXCLUDE_FROM_ALL)
     set_target_properties(GeographicLib_STATIC PROPERTIES POSITION_INDEPENDENT_CODE ON)
     target_link_libraries(pdnav_geographiclib INTERFACE GeographicLib::GeographicLib_STATIC)
-  endif()
-endif()
-
-if(NOT ANDROID)
-  # Host-only tools (CLI, tests, benchmarks).
-  find_package(CLI11 2.1 REQUIRED CONFIG)
-  find_package(nlohmann_json 3.11 REQUIRED CONFIG)
-  if(PDNAV_BUILD_TESTS)
-    find_package(GTest 1.12 REQUIRED CONFIG)
-  endif()
-  if(PDNAV_BUILD_BENCHMARKS)
-    find_package(benchmark 1.7 REQUIRED CONFIG)
   endif()
 endif()

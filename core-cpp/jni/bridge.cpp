@@ -24,7 +24,6 @@ namespace {
 using NavHandle = Handle<fusion::Navigator>;
 using RecHandle = Handle<io::LogWriter>;
 using ReaderHandle = Handle<io::LogReader>;
-using RouterHandle = Handle<route::Router>;
 
 constexpr const char* kBridgeClass = "org/pdnav/app/nav/NativeBridge";
 constexpr const char* kEstimateClass = "org/pdnav/app/nav/NavEstimate";
@@ -472,6 +471,8 @@ jdoubleArray dem_bounds(JNIEnv* env, jclass, jstring path) {
 }
 
 // ---- router (route::Router on a loaded walkway graph) ------------------------------------
+
+using RouterHandle = Handle<route::Router>;
 
 jlong route_open(JNIEnv* env, jclass, jstring path) {
   return guarded<jlong>(env, 0, [&] {
