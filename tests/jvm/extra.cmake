@@ -41,6 +41,7 @@ set_tests_properties(apk_debug_assemble_verify PROPERTIES LABELS "apk" TIMEOUT 9
 set_tests_properties(jvm_app_and_bridge PROPERTIES FIXTURES_SETUP pdnav_screens)
 add_test(NAME jvm_screen_pictures
          COMMAND /usr/bin/python3 "${CMAKE_CURRENT_LIST_DIR}/check_screens.py" "${_pdnav_android_out}/screens"
-                 main-map permission-explanation sessions settings satellites)
+                 main-map permission-explanation sessions settings satellites
+                 main-walker main-details regions goto goto-uncertain places out-of-region)
 set_tests_properties(jvm_screen_pictures PROPERTIES LABELS "jvm" FIXTURES_REQUIRED pdnav_screens)
 # ---- issue 21 (end) ----

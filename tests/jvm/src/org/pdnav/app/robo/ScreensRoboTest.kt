@@ -44,6 +44,7 @@ import org.robolectric.annotation.LooperMode
 import kotlin.math.abs
 import kotlin.math.hypot
 import kotlin.test.assertEquals
+import kotlin.test.assertFalse
 import kotlin.test.assertNotNull
 import kotlin.test.assertNull
 import kotlin.test.assertTrue
@@ -188,9 +189,22 @@ class ScreensRoboTest {
         assertTrue(near >= onScreen.size * 6 / 10, "track drawn near $near of ${onScreen.size} vertices")
 
         // status line: engine and reason, not clipped
-        val status = activity.findViewById<android.widget.TextView>(R.id.status_text)
-        assertTrue(status.text.contains("terrain"), "status: ${status.text}")
+        // the tester's engine line is behind one tap; the walker reads words (issue 29)
+        val details = activity.findViewById<android.widget.TextView>(R.id.details_text)
+        assertTrue(details.text.contains("terrain"), "details: ${details.text}")
+        val source = activity.findViewById<android.widget.TextView>(R.id.walker_source).text.toString()
+        assertTrue(source.startsWith("No satellites: terrain"), "source in words: $source")
+        val shown = visibleText(decor)
+        for (jargon in listOf("PF", "particles", "engine", "σ")) assertFalse(shown.contains(jargon), "\"$jargon\" on the walker's screen: $shown")
         BasemapFixture.assertTextNotClipped(decor, pic, "main map")
+    }
+
+    /** All text of the visible TextViews under [v]. */
+    private fun visibleText(v: View): String {
+        if (v.visibility != View.VISIBLE) return ""
+        if (v is android.widget.TextView) return v.text.toString() + "\n"
+        if (v is android.view.ViewGroup) return (0 until v.childCount).joinToString("") { visibleText(v.getChildAt(it)) }
+        return ""
     }
 
     @Test
@@ -352,6 +366,17 @@ class ScreensRoboTest {
         val counters = activity.findViewById<android.widget.TextView>(R.id.counters_text)
         assertTrue(counters.text.contains("3/5 satellites used"), "counters: ${counters.text}")
         assertTrue(counters.text.contains("wave the phone"), "magnetometer unreliable is shown: ${counters.text}")
+        // the legend names each constellation in its colour (issue 29)
+        val legend = activity.findViewById<android.widget.TextView>(R.id.sky_legend)
+        assertEquals(View.VISIBLE, legend.visibility, "legend shown with the plot")
+        val spanned = legend.text as android.text.Spanned
+        for (c in listOf(1, 3, 5, 6)) {
+            val name = SkyPlotView.constellationName(c)
+            val at = legend.text.indexOf("●\u00A0$name")
+            assertTrue(at >= 0, "legend names $name: ${legend.text}")
+            val spans = spanned.getSpans(at, at + 1, android.text.style.ForegroundColorSpan::class.java)
+            assertEquals(SkyPlotView.constellationColor(c), spans.single().foregroundColor, "legend dot of $name in its colour")
+        }
         BasemapFixture.assertTextNotClipped(decor, pic, "satellite view")
     }
 }

@@ -424,4 +424,48 @@ class ServiceRoboTest {
         assertTrue(NavigationSession.KEY_END to "interrupted" in meta, "end marker appended: $meta")
         assertNull(SessionStore(app).recoverInterrupted(), "found once")
     }
+
+    /**
+     * Issue 29: Go-to chosen on the Places screen reaches the service through the map screen;
+     * the in-app replay (owned by the service) opens on the installed region by itself and
+     * publishes the walker's state with Go-to to the screen.
+     */
+    @Test
+    fun goToFromThePlacesScreenReachesTheServiceAndTheReplayPublishesIt() {
+        shadowOf(app).grantPermissions(android.Manifest.permission.ACCESS_FINE_LOCATION, android.Manifest.permission.ACCESS_COARSE_LOCATION,
+            android.Manifest.permission.ACTIVITY_RECOGNITION)
+        val pack = RegionFixture.build("Engolasters", "--center", "${BasemapFixture.CENTER_LAT},${BasemapFixture.CENTER_LON}",
+            "--radius", "${BasemapFixture.RADIUS_M}")
+        pack.inputStream().use { org.pdnav.app.region.RegionStore(app.filesDir).install(it, pack.name) }
+        val (_, log) = BasemapFixture.simulatedWalk()
+        val service = Robolectric.buildService(NavigationService::class.java).create().get()
+        shadowOf(app).setComponentNameAndServiceForBindService(android.content.ComponentName(app, NavigationService::class.java),
+            service.onBind(android.content.Intent(app, NavigationService::class.java)))
+        val goTo = android.content.Intent(app, org.pdnav.app.ui.MainActivity::class.java)
+            .putExtra(org.pdnav.app.ui.MainActivity.EXTRA_GOTO_NAME, "Hut")
+            .putExtra(org.pdnav.app.ui.MainActivity.EXTRA_GOTO_LAT, 42.51881)
+            .putExtra(org.pdnav.app.ui.MainActivity.EXTRA_GOTO_LON, 1.56896)
+        val screen = Robolectric.buildActivity(org.pdnav.app.ui.MainActivity::class.java, goTo).setup()
+        shadowOf(Looper.getMainLooper()).idle()
+        assertEquals("Hut", service.goToTarget?.name, "the map screen handed Go-to to the service")
+        val walks = ArrayList<org.pdnav.app.walk.WalkState>()
+        service.addListener(object : NavigationService.Listener {
+            override fun onOutput(output: NavOutput, track: List<DoubleArray>) = Unit
+            override fun onWalk(state: org.pdnav.app.walk.WalkState) { walks += state }
+        })
+        assertTrue(service.startReplay(log.path))
+        val task = assertNotNull(service.replay)
+        task.join(120_000)
+        shadowOf(Looper.getMainLooper()).idle()
+        assertEquals("Engolasters", service.region?.name, "the replay opened on the region containing its start")
+        val g = assertNotNull(service.lastWalk?.goTo, "Go-to published")
+        assertEquals("Hut", g.place.name)
+        assertNotNull(g.route, "a walkway route to the hut")
+        // one report per 512-row batch: this sparse simulated log (~10 rows/s) gives one every ~50 s
+        assertTrue(walks.mapNotNull { it.goTo }.map { it.straightM }.distinct().size >= 5, "updates as the walk goes: ${walks.size}")
+        val text = screen.get().findViewById<android.widget.TextView>(org.pdnav.app.R.id.goto_text).text.toString()
+        assertTrue(text.startsWith("Go to Hut: ") && text.contains("along paths"), "the screen shows it: $text")
+        assertEquals("Map: Engolasters", screen.get().findViewById<android.widget.TextView>(org.pdnav.app.R.id.region_text).text.toString())
+        screen.destroy()
+    }
 }

@@ -40,8 +40,20 @@ class MapController(context: Context, val map: MapView) {
     private val engineDots = EngineOverlay()
     private val fixCircle = Polygon(map)
     private val fixMarker = Marker(map)
+    /** Go-to: the shortest walkway route (core router) and the place it leads to. */
+    val routeLine = Polyline(map)
+    private val targetMarker = Marker(map)
     private val density = context.resources.displayMetrics.density
     var showParticles = true
+
+    /** The tester's layers (each engine's ring, the particle cloud): shown with the details. */
+    var testerLayers: Boolean
+        get() = cloud.isEnabled
+        set(v) {
+            cloud.isEnabled = v
+            engineDots.isEnabled = v
+            map.invalidate()
+        }
 
     /** Follow the estimate (re-centre on every output) or leave the map where the user put it. */
     var follow = true
@@ -56,7 +68,7 @@ class MapController(context: Context, val map: MapView) {
         cfg.osmdroidTileCache = File(context.cacheDir, "osmdroid-tiles")
         map.setUseDataConnection(false)  // offline only
         map.setMultiTouchControls(true)
-        map.controller.setZoom(17.0)
+        map.controller.setZoom(DEFAULT_ZOOM)
         marker.setAnchor(Marker.ANCHOR_CENTER, Marker.ANCHOR_CENTER)  // the icon's centre is the position
         marker.icon = android.graphics.drawable.BitmapDrawable(context.resources, arrowBitmap(Color.rgb(30, 111, 217), density))
         marker.isFlat = true  // the arrow keeps its bearing when the map rotates
@@ -72,6 +84,16 @@ class MapController(context: Context, val map: MapView) {
         ellipse.outlinePaint.strokeWidth = 3f
         trackLine.outlinePaint.color = Color.argb(220, 217, 80, 30)
         trackLine.outlinePaint.strokeWidth = 6f
+        routeLine.outlinePaint.color = ROUTE_COLOR
+        routeLine.outlinePaint.strokeWidth = 5f * density
+        routeLine.infoWindow = null
+        targetMarker.setAnchor(Marker.ANCHOR_CENTER, Marker.ANCHOR_CENTER)
+        targetMarker.icon = android.graphics.drawable.BitmapDrawable(context.resources, dotBitmap(ROUTE_COLOR, density * 1.4f))
+        targetMarker.title = "Go to"
+        map.overlays.add(routeLine)
+        map.overlays.add(targetMarker)
+        routeLine.isEnabled = false
+        targetMarker.isEnabled = false
         map.overlays.add(trackLine)
         map.overlays.add(fixCircle)
         map.overlays.add(ellipse)
@@ -81,6 +103,8 @@ class MapController(context: Context, val map: MapView) {
         map.overlays.add(marker)
         marker.isEnabled = false
         ellipse.isEnabled = false
+        cloud.isEnabled = false
+        engineDots.isEnabled = false
         fixMarker.isEnabled = false
         fixCircle.isEnabled = false
         map.setOnTouchListener { _, ev ->
@@ -116,6 +140,28 @@ class MapController(context: Context, val map: MapView) {
     }
 
     val graphEdgeCount: Int get() = graphLines.size
+
+    /** Go-to: draws [route] (lat, lon points) and the place; null hides them. */
+    fun showGoTo(targetLatDeg: Double, targetLonDeg: Double, route: List<DoubleArray>?) {
+        if (!targetLatDeg.isFinite()) {
+            routeLine.isEnabled = false
+            targetMarker.isEnabled = false
+            map.invalidate()
+            return
+        }
+        targetMarker.position = GeoPoint(targetLatDeg, targetLonDeg)
+        targetMarker.isEnabled = true
+        if (route != null && route.size >= 2) {
+            routeLine.setPoints(route.map { GeoPoint(it[0], it[1]) })
+            routeLine.isEnabled = true
+        } else {
+            routeLine.isEnabled = false
+        }
+        map.invalidate()
+    }
+
+    val routePointCount: Int get() = if (routeLine.isEnabled) routeLine.actualPoints.size else 0
+    val targetShown: Boolean get() = targetMarker.isEnabled
 
     /** Area the basemap covers, once loaded. */
     var basemapBounds: GeoBounds? = null
@@ -171,6 +217,11 @@ class MapController(context: Context, val map: MapView) {
         map.setTileSource(source)
         map.setUseDataConnection(false)
         basemapBounds = MbtilesBounds.read(file)?.also { centerOn(it) }
+        // offline tiles only: never zoom past the deepest zoom the file has (blank grid there)
+        MbtilesBounds.maxZoom(file)?.let { z ->
+            map.maxZoomLevel = z.toDouble()
+            map.controller.setZoom(minOf(DEFAULT_ZOOM, z.toDouble()))
+        }
         return true
     }
 
@@ -234,6 +285,8 @@ class MapController(context: Context, val map: MapView) {
 
     companion object {
         private val FIX_COLOR = Color.rgb(120, 60, 200)
+        /** Go-to route and place: a saturated blue-green no basemap layer uses. */
+        val ROUTE_COLOR = Color.rgb(0, 150, 200)
 
         /** Colour of each engine (EngineKind order): none, DR, terrain, route, GNSS. */
         val ENGINE_COLORS = intArrayOf(Color.GRAY, Color.rgb(230, 140, 0), Color.rgb(40, 160, 60),
@@ -282,6 +335,8 @@ class MapController(context: Context, val map: MapView) {
             c.drawCircle(size / 2f, size / 2f, size / 2f - 2 * density, Paint(Paint.ANTI_ALIAS_FLAG).apply { this.color = color })
             return b
         }
+
+        const val DEFAULT_ZOOM = 17.0
 
         /** 95 % content of a 2D Gaussian: k = sqrt(-2 ln 0.05). */
         const val K95 = 2.4477

@@ -35,6 +35,32 @@ object MbtilesBounds {
         }
     }
 
+    /** The deepest zoom level with tiles, or null. */
+    fun maxZoom(file: File): Int? {
+        if (!file.isFile) return null
+        return try {
+            SQLiteDatabase.openDatabase(file.path, null, SQLiteDatabase.OPEN_READONLY).use { db ->
+                db.rawQuery("SELECT MAX(zoom_level) FROM tiles", null).use { c -> if (c.moveToFirst() && !c.isNull(0)) c.getInt(0) else null }
+            }
+        } catch (e: SQLiteException) {
+            null
+        }
+    }
+
+    /** The `attribution` row of the metadata table (MBTiles 1.3), or null. */
+    fun attribution(file: File): String? {
+        if (!file.isFile) return null
+        return try {
+            SQLiteDatabase.openDatabase(file.path, null, SQLiteDatabase.OPEN_READONLY).use { db ->
+                db.rawQuery("SELECT value FROM metadata WHERE name = 'attribution'", null).use { c ->
+                    if (c.moveToFirst() && !c.isNull(0)) c.getString(0).trim().ifEmpty { null } else null
+                }
+            }
+        } catch (e: SQLiteException) {
+            null
+        }
+    }
+
     private fun fromMetadata(db: SQLiteDatabase): GeoBounds? = try {
         db.rawQuery("SELECT value FROM metadata WHERE name = 'bounds'", null).use { c ->
             if (!c.moveToFirst()) return null

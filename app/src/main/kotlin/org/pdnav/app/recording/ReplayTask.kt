@@ -6,6 +6,11 @@ import org.pdnav.app.nav.NavOutput
 import org.pdnav.app.nav.NavigatorConfig
 import org.pdnav.app.nav.SampleBatch
 import org.pdnav.app.nav.SessionFeeder
+import org.pdnav.app.region.Place
+import org.pdnav.app.region.RegionInfo
+import org.pdnav.app.region.RegionStore
+import org.pdnav.app.walk.RegionalNavigator
+import org.pdnav.app.walk.WalkState
 
 /**
  * Replays a recorded session through a fresh navigator on a background thread (owned by
@@ -23,12 +28,26 @@ class ReplayTask(
     private val onDone: (NavOutput?, Exception?) -> Unit,
     private val everyNs: Long = 1_000_000_000L,
     private val chunk: Int = CHUNK,
+    /** Installed regions: the replay picks the one its walk starts in, as the live session did. */
+    private val regions: RegionStore? = null,
+    /** Go-to during the replay (bearing, distance and route per step). */
+    private val target: Place? = null,
+    /** The walker's state at every progress report and at the end. */
+    private val onWalk: (WalkState) -> Unit = {},
 ) {
     @Volatile private var cancelled = false
     private var thread: Thread? = null
 
     /** Checkpoints scored (after the replay, or so far). */
     @Volatile var checkpoints: List<SessionFeeder.Checkpoint> = emptyList()
+        private set
+
+    /** The region the replay opened on (null: the settings' files). */
+    @Volatile var region: RegionInfo? = null
+        private set
+
+    /** The walker's state at the last report. */
+    @Volatile var walk: WalkState? = null
         private set
 
     /** JNI calls that fed rows (the batching check). */
@@ -55,26 +74,31 @@ class ReplayTask(
     fun run() {
         try {
             var last: NavOutput? = null
-            NativeNavigator(config, seed).use { nav ->
-                val feeder = SessionFeeder(nav)
+            RegionalNavigator(config, seed, regions, null, saveStart = false) { r -> region = r.region }.use { rn ->
+                rn.setTarget(target)
                 NativeLogReader(path).use { reader ->
                     val batch = SampleBatch(chunk)
                     var nextReportNs = Long.MIN_VALUE
                     while (!cancelled && reader.read(batch, chunk)) {
-                        feeder.write(batch)
-                        feedCalls = feeder.feedCalls
+                        rn.write(batch)
+                        feedCalls = rn.feeder?.feedCalls ?: 0L
+                        val nav = rn.navigator ?: continue
                         val t = batch.tNs(batch.size - 1)
                         if (nextReportNs == Long.MIN_VALUE) nextReportNs = batch.tNs(0) + everyNs
                         if (t >= nextReportNs) {
                             nextReportNs = t + everyNs
                             val out = nav.output(200)
                             last = out
+                            rn.tracker?.let { walk = it.state; onWalk(it.state) }
                             onProgress(out, reader.progress)
                         }
                     }
                 }
-                checkpoints = feeder.checkpoints
-                last = nav.output(200)
+                rn.finish()
+                checkpoints = rn.feeder?.checkpoints ?: emptyList()
+                feedCalls = rn.feeder?.feedCalls ?: 0L
+                last = rn.navigator?.output(200)
+                rn.tracker?.let { walk = it.state; onWalk(it.state) }
             }
             onDone(last, null)
         } catch (e: Exception) {

@@ -22,6 +22,10 @@ import org.pdnav.app.R
 import org.pdnav.app.nav.NavOutput
 import org.pdnav.app.nav.SampleSink
 import org.pdnav.app.recording.ReplayTask
+import org.pdnav.app.region.Place
+import org.pdnav.app.region.RegionInfo
+import org.pdnav.app.region.RegionStore
+import org.pdnav.app.walk.WalkState
 import org.pdnav.app.recording.SessionStore
 import org.pdnav.app.ui.AppSettings
 import org.pdnav.app.ui.MainActivity
@@ -46,6 +50,10 @@ class NavigationService : Service() {
         fun onStats(stats: SessionStats) = Unit
         /** Replay progress (fraction 0..1), and its end ([done], with the error if it failed). */
         fun onReplay(output: NavOutput?, fraction: Double, done: Boolean, error: String?) = Unit
+        /** The walker's state (distance, time, region, Go-to) after the latest steps. */
+        fun onWalk(state: WalkState) = Unit
+        /** The session (or replay) opened on [region] (null: the settings' files). */
+        fun onRegion(region: RegionInfo?) = Unit
     }
 
     inner class LocalBinder : Binder() {
@@ -83,6 +91,18 @@ class NavigationService : Service() {
     var lastOutput: NavOutput? = null
         private set
     var lastStats: SessionStats? = null
+        private set
+
+    /** The walker's latest state (live or replay), for a screen that binds later. */
+    var lastWalk: WalkState? = null
+        private set
+
+    /** The region the current (or last) session or replay navigates on. */
+    var region: RegionInfo? = null
+        private set
+
+    /** The Go-to target (kept across the session's start and a replay). */
+    var goToTarget: Place? = null
         private set
 
     /** Why the last session ended on an error (e.g. an unreadable DEM file, a full disk), or null. */
@@ -149,7 +169,10 @@ class NavigationService : Service() {
         val s = session ?: startSession(navigate = false, record = false) ?: return
         val h = workerHandler ?: return
         h.post {
-            if (navigate && !s.navigating) s.startNavigation(declaredStart)
+            if (navigate && !s.navigating) {
+                s.startNavigation(declaredStart)
+                s.setGoTo(goToTarget)
+            }
             if (!navigate && s.navigating) s.stopNavigation()
             if (record && !s.recording) startRecordingOn(s)
             if (!record && s.recording) {
@@ -186,6 +209,7 @@ class NavigationService : Service() {
             workerHandler = h
             track.clear()
             lastOutput = null
+            lastWalk = null
             val s = NavigationSession(
                 handler = h,
                 sensorManager = getSystemService(Context.SENSOR_SERVICE) as SensorManager,
@@ -196,11 +220,16 @@ class NavigationService : Service() {
                 extraSinks = testSinks,
                 fullTracking = settings.fullTracking,
                 wantOutput = { listeners.isNotEmpty() },
+                regions = RegionStore(filesDir),
+                filesDir = filesDir,
             )
             session = s
             h.post {
                 if (s.open()) {
-                    if (navigate) s.startNavigation(declaredStart)
+                    if (navigate) {
+                        s.startNavigation(declaredStart)
+                        s.setGoTo(goToTarget)
+                    }
                     if (record && s.error == null) startRecordingOn(s)
                 }
                 mainHandler.post { stateChanged() }
@@ -215,6 +244,8 @@ class NavigationService : Service() {
     private fun sessionEvents() = object : NavigationSession.Events {
         override fun onOutput(out: NavOutput) { mainHandler.post { publish(out) } }
         override fun onStats(stats: SessionStats) { mainHandler.post { publishStats(stats) } }
+        override fun onWalk(state: WalkState) { mainHandler.post { publishWalk(state) } }
+        override fun onRegion(region: RegionInfo?) { mainHandler.post { publishRegion(region) } }
         override fun onError(message: String, error: Throwable) {
             mainHandler.post { endAfter(message) }
         }
@@ -270,6 +301,20 @@ class NavigationService : Service() {
         return true
     }
 
+    /** Go-to [place] (null: stop): the running session or replay uses it from its next step. */
+    fun setGoTo(place: Place?) {
+        goToTarget = place
+        val s = session ?: return
+        workerHandler?.post { s.setGoTo(place) }
+    }
+
+    /** The walker's current position (latest step, else the latest estimate), or null. */
+    fun currentPosition(): DoubleArray? {
+        lastWalk?.step?.let { return doubleArrayOf(it.latDeg, it.lonDeg) }
+        val e = lastOutput?.estimate ?: return null
+        return if (e.valid && e.latDeg.isFinite()) doubleArrayOf(e.latDeg, e.lonDeg) else null
+    }
+
     /** A long-press start during a session: applied now and recorded in the stream. */
     fun declareStart(latDeg: Double, lonDeg: Double, sigmaM: Double): Boolean {
         val s = session ?: return false
@@ -287,6 +332,7 @@ class NavigationService : Service() {
         }
         replay?.cancel()
         val settings = AppSettings(getSharedPreferences(AppSettings.PREFS, Context.MODE_PRIVATE))
+        lastWalk = null
         val task = ReplayTask(path, settings.navigatorConfig(), REPLAY_SEED,
             onProgress = { out, frac ->
                 mainHandler.post {
@@ -303,7 +349,9 @@ class NavigationService : Service() {
                     stateChanged()
                     if (session == null) stopSelf()
                 }
-            })
+            },
+            regions = RegionStore(this.filesDir), target = goToTarget,
+            onWalk = { w -> mainHandler.post { if (w.region?.name != region?.name) publishRegion(w.region); publishWalk(w) } })
         replay = task
         replayPath = path
         replayState = ReplayState(null, 0.0, false, null)
@@ -348,6 +396,16 @@ class NavigationService : Service() {
         for (i in half until track.size) kept += track[i]
         track.clear()
         track.addAll(kept)
+    }
+
+    private fun publishWalk(w: WalkState) {
+        lastWalk = w
+        listeners.toList().forEach { it.onWalk(w) }
+    }
+
+    private fun publishRegion(r: RegionInfo?) {
+        region = r
+        listeners.toList().forEach { it.onRegion(r) }
     }
 
     private fun publishStats(stats: SessionStats) {

@@ -13,6 +13,10 @@ import org.pdnav.app.nav.SampleBatch
 import org.pdnav.app.nav.SampleKind
 import org.pdnav.app.nav.SampleSink
 import org.pdnav.app.nav.SessionFeeder
+import org.pdnav.app.region.RegionInfo
+import org.pdnav.app.region.RegionStore
+import org.pdnav.app.walk.RegionalNavigator
+import org.pdnav.app.walk.WalkState
 import java.io.File
 import java.io.FileInputStream
 
@@ -41,6 +45,10 @@ class NavigationSession(
     private val syncFile: (File) -> Unit = ::fsync,
     private val wantOutput: () -> Boolean = { true },
     private val device: String = android.os.Build.MODEL ?: "",
+    /** Installed regions (the navigator opens on the one the walk is in); null: settings' files only. */
+    private val regions: RegionStore? = null,
+    /** App storage for the places (the session start is saved there); null: not saved. */
+    private val filesDir: File? = null,
 ) {
     /** What the session reports (called on the worker thread). */
     interface Events {
@@ -48,12 +56,17 @@ class NavigationSession(
         fun onStats(stats: SessionStats) = Unit
         /** The session ended on [error]; the recording (if any) is closed and kept. */
         fun onError(message: String, error: Throwable) = Unit
+        /** The walker's state after the latest per-step estimates (issue 29). */
+        fun onWalk(state: WalkState) = Unit
+        /** The navigator opened on [region] (null: the settings' files). */
+        fun onRegion(region: RegionInfo?) = Unit
     }
 
-    @Volatile var navigator: NativeNavigator? = null
+    /** The navigator, on the region the walk is in (opened once the stream shows where). */
+    @Volatile var regional: RegionalNavigator? = null
         private set
-    @Volatile var feeder: SessionFeeder? = null
-        private set
+    val navigator: NativeNavigator? get() = regional?.navigator
+    val feeder: SessionFeeder? get() = regional?.feeder
     @Volatile var recorder: NativeRecorder? = null
         private set
     @Volatile var recordFile: File? = null
@@ -78,7 +91,7 @@ class NavigationSession(
     private var recordStartNs = 0L
     private val startNs = clockNs()
 
-    val navigating: Boolean get() = navigator != null
+    val navigating: Boolean get() = regional != null
     val recording: Boolean get() = recorder != null
 
     private val tick = object : Runnable {
@@ -103,19 +116,16 @@ class NavigationSession(
      * session's start: written into the stream (and so the recording) as Meta lines.
      */
     fun startNavigation(declaredStart: DoubleArray? = null): Boolean = guarded("navigation") {
-        if (navigator != null) return@guarded
-        val nav = NativeNavigator(config, seed)
-        navigator = nav
-        feeder = SessionFeeder(nav)
+        if (regional != null) return@guarded
+        regional = RegionalNavigator(config, seed, regions, filesDir, saveStart = true) { events.onRegion(it.region) }
         updateSinks()
         if (declaredStart != null) declareStart(declaredStart[0], declaredStart[1], declaredStart[2])
     }
 
     fun stopNavigation() = guarded("stop navigation") {
-        val nav = navigator ?: return@guarded
+        val nav = regional ?: return@guarded
         merger.flush(clockNs(), all = true)
-        navigator = null
-        feeder = null
+        regional = null
         updateSinks()
         nav.close()
     }
@@ -173,7 +183,7 @@ class NavigationSession(
     }
 
     private fun updateSinks() {
-        merger.setSinks(listOfNotNull<SampleSink>(recorder, feeder) + extraSinks)
+        merger.setSinks(listOfNotNull<SampleSink>(recorder, regional) + extraSinks)
     }
 
     /** Pumps when the last pump is [TICK_NS] old (called from every callback). */
@@ -199,7 +209,10 @@ class NavigationSession(
                 }
             }
             val nav = navigator
-            if (nav != null && wantOutput()) events.onOutput(nav.output(MAX_PARTICLES))
+            if (nav != null && wantOutput()) {
+                events.onOutput(nav.output(MAX_PARTICLES))
+                regional?.tracker?.let { events.onWalk(it.state) }
+            }
             events.onStats(stats())
         }
     }
@@ -208,6 +221,11 @@ class NavigationSession(
     fun declareStart(latDeg: Double, lonDeg: Double, sigmaM: Double) {
         val t = clockNs()
         merger.add { b -> SessionFeeder.addDeclaredStart(b, t, latDeg, lonDeg, sigmaM) }
+    }
+
+    /** Go-to [place] (null: stop); applied from the next step on. */
+    fun setGoTo(place: org.pdnav.app.region.Place?) {
+        regional?.setTarget(place)
     }
 
     /** A checkpoint: the tester is at this known point now (a `Truth` line). */
@@ -269,12 +287,13 @@ class NavigationSession(
         step { sensors.stop() }
         step { gnss.stop() }
         step { merger.flush(clockNs(), all = true) }
+        step { regional?.finish() }  // end of input: the core releases a short last walk
         step { navigator?.let { if (wantOutput()) events.onOutput(it.output(MAX_PARTICLES)) } }
+        step { regional?.tracker?.let { if (wantOutput()) events.onWalk(it.state) } }
         step { events.onStats(stats()) }
         step { recorder?.let { endRecording(it, reason) } }
-        step { navigator?.close() }
-        navigator = null
-        feeder = null
+        step { regional?.close() }
+        regional = null
         first?.let { e -> if (error == null) report(e, "stop") }
     }
 

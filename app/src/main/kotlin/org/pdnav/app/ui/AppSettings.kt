@@ -34,6 +34,10 @@ class AppSettings(private val prefs: SharedPreferences) {
     var basemapPath: String
         get() = prefs.getString(KEY_BASEMAP, "") ?: ""
         set(v) = prefs.edit().putString(KEY_BASEMAP, v).apply()
+    /** The region last imported or navigated in: the map opens on it. */
+    var lastRegion: String
+        get() = prefs.getString(KEY_REGION, "") ?: ""
+        set(v) = prefs.edit().putString(KEY_REGION, v).apply()
     var navPath: String
         get() = prefs.getString(KEY_NAV, "") ?: ""
         set(v) = prefs.edit().putString(KEY_NAV, v).apply()
@@ -74,5 +78,6 @@ class AppSettings(private val prefs: SharedPreferences) {
         private const val KEY_GRAPH = "graph_path"
         private const val KEY_BASEMAP = "basemap_path"
         private const val KEY_NAV = "nav_path"
+        private const val KEY_REGION = "last_region"
     }
 }

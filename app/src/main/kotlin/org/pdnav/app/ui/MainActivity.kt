@@ -30,16 +30,29 @@ import org.pdnav.app.map.MapData
 import org.pdnav.app.nav.NavOutput
 import org.pdnav.app.sensors.NavigationService
 import org.pdnav.app.sensors.SessionStats
+import org.pdnav.app.map.MbtilesBounds
+import org.pdnav.app.region.Place
+import org.pdnav.app.region.PlaceStore
+import org.pdnav.app.region.RegionInfo
+import org.pdnav.app.region.RegionStore
+import org.pdnav.app.walk.GoTo
+import org.pdnav.app.walk.WalkState
+import org.pdnav.app.walk.WalkerWords
+import org.pdnav.app.walk.remainingM
+import org.pdnav.app.walk.sigmaM
 import java.io.File
 import java.util.Locale
 
 /**
- * The map screen: offline basemap with the estimate (arrow), its error ellipse, the track,
- * each engine, the phone's own fix and the particle cloud; position, sigma and engine as
- * numbers; the live state of the session (duration, file size, rows per line type, GNSS
- * epochs, magnetometer accuracy); Navigate and Record as independent switches, Checkpoint,
- * Follow, Satellites (sky plot), Settings, Sessions. Asks for location (required), physical
- * activity and notifications (optional) and explains what a refusal costs.
+ * The walker's map screen: offline basemap (of the region the walk is in) with its
+ * attribution, the estimate (arrow), its error ellipse and the track; what a walker needs in
+ * words (how sure the position is, where it comes from, heading, distance and time walked,
+ * leaving the region's map); Go-to (bearing, straight distance, the walkway route drawn,
+ * or a warning when the position is too uncertain); places (save, long-press, list). The
+ * tester's details (engine line, numbers, each engine, the particle cloud, the session's
+ * live counters) are one tap away. Navigate and Record are independent switches. Asks for
+ * location (required), physical activity and notifications (optional) and explains what a
+ * refusal costs.
  */
 class MainActivity : Activity() {
     private lateinit var settings: AppSettings
@@ -57,6 +70,27 @@ class MainActivity : Activity() {
     private lateinit var checkpointButton: Button
     private lateinit var followButton: Button
     private lateinit var skyPlot: SkyPlotView
+    private lateinit var skyLegend: TextView
+    private lateinit var walkerPanel: LinearLayout
+    private lateinit var walkerPosition: TextView
+    private lateinit var walkerSource: TextView
+    private lateinit var walkerHeading: TextView
+    private lateinit var walkerWalked: TextView
+    private lateinit var regionText: TextView
+    private lateinit var detailsPanel: LinearLayout
+    private lateinit var detailsText: TextView
+    private lateinit var gotoPanel: LinearLayout
+    private lateinit var gotoText: TextView
+    private lateinit var gotoArrow: GoToArrowView
+    private lateinit var attribution: TextView
+    private var lastOut: NavOutput? = null
+    private var lastWalk: WalkState? = null
+    private var graphShown = false
+    private var pendingGoTo: Place? = null
+
+    /** The region whose map is shown (null: the settings' single files, or nothing). */
+    var shownRegion: RegionInfo? = null
+        private set
     private var service: NavigationService? = null
     private var bound = false
     private var asked = false
@@ -79,6 +113,14 @@ class MainActivity : Activity() {
         }
         override fun onState() = updateButtons()
         override fun onStats(stats: SessionStats) = showStats(stats)
+        override fun onWalk(state: WalkState) = showWalk(state)
+        override fun onRegion(region: RegionInfo?) {
+            if (region != null) {
+                settings.lastRegion = region.name
+                if (region.name != shownRegion?.name) showRegionMap(region)
+            }
+            updateRegionMessage()
+        }
         override fun onReplay(output: NavOutput?, fraction: Double, done: Boolean, error: String?) {
             if (output != null) showOutput(output, emptyList())
             val name = service?.replayPath?.let { File(it).name } ?: ""
@@ -99,6 +141,12 @@ class MainActivity : Activity() {
             s.lastOutput?.let { showOutput(it, s.track) }
             s.lastStats?.let { showStats(it) }
             s.lastError?.let { status.text = getString(R.string.status_error, it) }
+            s.region?.let { listener.onRegion(it) }
+            s.lastWalk?.let { showWalk(it) }
+            pendingGoTo?.let {
+                pendingGoTo = null
+                s.setGoTo(it)
+            }
             s.replayState?.let { listener.onReplay(it.output, it.fraction, it.done, it.error) }  // e.g. after a rotation
             pendingReplay?.let {
                 pendingReplay = null
@@ -120,11 +168,12 @@ class MainActivity : Activity() {
         setContentView(buildLayout())
         pendingStart = savedInstanceState?.getDoubleArray(STATE_START)
         asked = savedInstanceState?.getBoolean(STATE_ASKED) ?: false
-        mapController.setOnLongPress { p -> declareStart(p.latitude, p.longitude) }
+        mapController.setOnLongPress { p -> onMapLongPress(p.latitude, p.longitude) }
         mapController.onFollowChanged = { updateFollow() }
         status.text = getString(R.string.status_idle)
         if (savedInstanceState?.getBoolean(STATE_ASKED) != true) ensurePermissions()
         pendingReplay = intent?.getStringExtra(EXTRA_REPLAY)
+        goToFromIntent(intent)
         if (savedInstanceState != null) pendingReplay = null  // a rotation: the service already replays it
     }
 
@@ -136,13 +185,22 @@ class MainActivity : Activity() {
 
     override fun onStart() {
         super.onStart()
-        val basemap = settings.basemapPath.takeIf { it.isNotEmpty() }?.let(::File)
-        val hasBasemap = mapController.loadBasemap(this, basemap)
-        if (!hasBasemap) {
-            status.text = getString(R.string.status_no_basemap)
-            centerOnLastFix()
+        val region = settings.lastRegion.takeIf { it.isNotEmpty() }?.let { RegionStore(filesDir).find(it) }
+        if (region != null) {
+            if (region.name != shownRegion?.name) showRegionMap(region)
+        } else {
+            shownRegion = null
+            val basemap = settings.basemapPath.takeIf { it.isNotEmpty() }?.let(::File)
+            val hasBasemap = mapController.loadBasemap(this, basemap)
+            if (!hasBasemap) {
+                status.text = getString(R.string.status_no_basemap)
+                centerOnLastFix()
+            }
+            loadMapData(settings.graphPath, settings.demPath, centerOnDem = !hasBasemap)
+            // the tester's single files: the basemap's own attribution, OSM's for its graph too
+            showAttribution(if (hasBasemap) basemap?.let { MbtilesBounds.attribution(it) } else null,
+                osmShown = hasBasemap || settings.graphPath.isNotEmpty())
         }
-        loadMapData(centerOnDem = !hasBasemap)
         bound = bindService(Intent(this, NavigationService::class.java), connection, Context.BIND_AUTO_CREATE)
     }
 
@@ -171,6 +229,128 @@ class MainActivity : Activity() {
     override fun onNewIntent(intent: Intent) {
         super.onNewIntent(intent)
         intent.getStringExtra(EXTRA_REPLAY)?.let { startReplay(it) }
+        goToFromIntent(intent)
+    }
+
+    // ---- regions, places, Go-to ---------------------------------------------------------------
+
+    /** Shows region [r]'s basemap, walkway graph and attribution. */
+    fun showRegionMap(r: RegionInfo) {
+        shownRegion = r
+        val has = mapController.loadBasemap(this, File(r.basemapPath))
+        loadMapData(r.graphPath, r.demPath, centerOnDem = !has)
+        showAttribution(r.attribution, osmShown = true)
+        updateRegionMessage()
+    }
+
+    /**
+     * The map's attribution: the data's own text; ODbL requires "© OpenStreetMap
+     * contributors" wherever OSM-derived tiles or the walkway graph are shown.
+     */
+    private fun showAttribution(declared: String?, osmShown: Boolean) {
+        var t = declared?.trim().orEmpty()
+        if (osmShown && !t.contains("OpenStreetMap")) t = if (t.isEmpty()) RegionStore.OSM_ATTRIBUTION else RegionStore.OSM_ATTRIBUTION + "; " + t
+        attribution.text = t
+        attribution.visibility = if (t.isEmpty()) View.GONE else View.VISIBLE
+    }
+
+    /** The region the walker is in (or whose map is shown): its places are listed and saved. */
+    fun currentRegionName(): String? = lastWalk?.region?.name ?: service?.region?.name ?: shownRegion?.name
+
+    fun places(): PlaceStore = PlaceStore(filesDir, currentRegionName())
+
+    /** Saves a place (button, long-press, checkpoint) in the current region's list. */
+    fun savePlace(name: String, latDeg: Double, lonDeg: Double, kind: String = Place.SAVED): Place {
+        val p = places().add(Place(name, latDeg, lonDeg, kind, System.currentTimeMillis()))
+        status.text = getString(R.string.place_saved, p.name)
+        return p
+    }
+
+    /** Go-to [place] (null: stop): the session computes bearing, distance and route per step. */
+    fun goTo(place: Place?) {
+        val s = service
+        if (s != null) s.setGoTo(place) else pendingGoTo = place
+        if (place == null) {
+            showGoTo(null)
+        } else {
+            mapController.showGoTo(place.latDeg, place.lonDeg, null)
+            gotoPanel.visibility = View.VISIBLE
+            gotoArrow.bearingDeg = Double.NaN
+            gotoText.text = getString(R.string.goto_waiting, place.name)
+        }
+    }
+
+    private fun goToFromIntent(i: Intent?) {
+        if (i == null || !i.hasExtra(EXTRA_GOTO_LAT)) return
+        val p = Place(i.getStringExtra(EXTRA_GOTO_NAME) ?: "?", i.getDoubleExtra(EXTRA_GOTO_LAT, Double.NaN),
+            i.getDoubleExtra(EXTRA_GOTO_LON, Double.NaN), Place.SAVED, 0L)
+        i.removeExtra(EXTRA_GOTO_LAT)
+        if (p.latDeg.isFinite() && p.lonDeg.isFinite()) goTo(p)
+    }
+
+    private fun askSavePlace(latDeg: Double, lonDeg: Double) {
+        val n = places().list().count { it.kind == Place.SAVED } + 1
+        val name = EditText(this).apply { setText(getString(R.string.place_default_name, n)) }
+        AlertDialog.Builder(this).setTitle(R.string.action_save_place).setView(name)
+            .setPositiveButton(R.string.settings_save) { _, _ -> savePlace(name.text.toString().ifBlank { "Place $n" }, latDeg, lonDeg) }
+            .setNegativeButton(android.R.string.cancel, null)
+            .show()
+    }
+
+    /** Long-press on the map: start here, save as a place, or go there. */
+    fun onMapLongPress(latDeg: Double, lonDeg: Double) {
+        val items = arrayOf(getString(R.string.longpress_start), getString(R.string.longpress_save), getString(R.string.longpress_goto))
+        AlertDialog.Builder(this).setItems(items) { _, which ->
+            when (which) {
+                0 -> declareStart(latDeg, lonDeg)
+                1 -> askSavePlace(latDeg, lonDeg)
+                2 -> goTo(Place(String.format(Locale.US, "%.5f, %.5f", latDeg, lonDeg), latDeg, lonDeg, Place.SAVED, 0L))
+            }
+        }.show()
+    }
+
+    /** The walker's state after the latest steps: heading, distance and time, region, Go-to. */
+    fun showWalk(w: WalkState) {
+        lastWalk = w
+        walkerHeading.text = w.step?.let { WalkerWords.heading(it.headingRad) } ?: ""
+        walkerWalked.text = if (w.steps > 0) WalkerWords.walked(w.distanceM, w.walkedNs) else ""
+        w.step?.let { walkerPosition.text = WalkerWords.position(it.sigmaM) }
+        updateRegionMessage()
+        showGoTo(w.goTo)
+    }
+
+    private fun showGoTo(g: GoTo?) {
+        if (g == null) {
+            gotoPanel.visibility = View.GONE
+            mapController.showGoTo(Double.NaN, Double.NaN, null)
+            return
+        }
+        gotoPanel.visibility = View.VISIBLE
+        gotoArrow.bearingDeg = g.bearingDeg
+        gotoArrow.uncertain = g.uncertain
+        val along = g.route?.let { getString(R.string.goto_along, WalkerWords.metres(it.remainingM)) } ?: getString(R.string.goto_no_route)
+        gotoText.text = if (g.uncertain) {
+            getString(R.string.goto_uncertain, g.place.name, WalkerWords.metres(g.sigmaM), WalkerWords.metres(g.straightM), along)
+        } else {
+            getString(R.string.goto_text, g.place.name, WalkerWords.metres(g.straightM), Math.round(g.bearingDeg).toInt() % 360,
+                WalkerWords.compass(g.bearingDeg), along)
+        }
+        mapController.showGoTo(g.place.latDeg, g.place.lonDeg, g.route?.points?.map { doubleArrayOf(it.first, it.second) })
+    }
+
+    /** Which map the walk is on, or that it has left it (navigation goes on). */
+    private fun updateRegionMessage() {
+        val w = lastWalk
+        val r = w?.region ?: service?.region
+        val outside = w != null && w.outsideRegion && r != null
+        regionText.text = when {
+            outside -> getString(R.string.region_left, r!!.name,
+                if (lastOut?.estimate?.engine == org.pdnav.app.nav.EngineKind.GNSS) getString(R.string.region_left_gnss) else getString(R.string.region_left_dr))
+            r != null -> getString(R.string.region_in, r.name)
+            shownRegion != null -> getString(R.string.region_shown, shownRegion!!.name)
+            else -> ""
+        }
+        regionText.setTextColor(if (outside) Color.rgb(176, 0, 32) else Color.DKGRAY)
     }
 
     // ---- permissions ------------------------------------------------------------------------
@@ -315,14 +495,18 @@ class MainActivity : Activity() {
     /** Writes a Truth line at [latDeg], [lonDeg] now; false when no session runs. */
     fun writeCheckpoint(latDeg: Double, lonDeg: Double): Boolean {
         val ok = service?.checkpoint(latDeg, lonDeg) == true
+        if (ok) {
+            // a checkpoint is a place too
+            places().add(Place(getString(R.string.place_checkpoint_name, java.text.SimpleDateFormat("HH:mm", Locale.US).format(java.util.Date())),
+                latDeg, lonDeg, Place.CHECKPOINT, System.currentTimeMillis()))
+        }
         status.text = if (ok) getString(R.string.checkpoint_written, latDeg, lonDeg) else getString(R.string.checkpoint_no_session)
         return ok
     }
 
     /** Walkway graph and DEM bounds, read on a thread (once per pair of files). */
-    private fun loadMapData(centerOnDem: Boolean) {
-        val graph = settings.graphPath
-        val dem = settings.demPath
+    private fun loadMapData(graph: String, dem: String, centerOnDem: Boolean) {
+        graphShown = graph.isNotEmpty()
         val key = "$graph|$dem"
         if (key == mapDataKey || (graph.isEmpty() && dem.isEmpty())) return
         mapDataKey = key
@@ -363,14 +547,28 @@ class MainActivity : Activity() {
     /** Shows one output: map layers, the status line and the numbers (position, sigma, engine). */
     fun showOutput(out: NavOutput, track: List<DoubleArray>) {
         mapController.show(out, track)
+        lastOut = out
         val e = out.estimate
-        status.text = "${e.statusText()} · ${out.steps} steps"
-        info.text = if (e.valid && e.latDeg.isFinite()) {
-            val sigma = Math.sqrt((e.covEastEastM2 + e.covNorthNorthM2).coerceAtLeast(0.0))
+        val has = e.valid && e.latDeg.isFinite()
+        val sigma = if (has) Math.sqrt((e.covEastEastM2 + e.covNorthNorthM2).coerceAtLeast(0.0)) else Double.NaN
+        // the walker's words
+        walkerPosition.text = WalkerWords.position(sigma)
+        walkerSource.text = WalkerWords.source(out, graphShown)
+        updateRegionMessage()
+        // the tester's line and numbers, one tap away
+        val numbers = if (has) {
             String.format(Locale.US, "%.6f, %.6f  ±%.1f m (1σ)  %s", e.latDeg, e.lonDeg, sigma, e.engine.label)
         } else {
             getString(R.string.info_no_position)
         }
+        detailsText.text = "${e.statusText()} · ${out.steps} steps\n$numbers"
+    }
+
+    /** Shows or hides the tester's details (one tap on the walker's panel). */
+    fun toggleDetails() {
+        val show = detailsPanel.visibility != View.VISIBLE
+        detailsPanel.visibility = if (show) View.VISIBLE else View.GONE
+        mapController.testerLayers = show  // each engine's ring and the particle cloud
     }
 
     /** Live state: duration, size, rows per line type, GNSS epochs, magnetometer accuracy, satellites. */
@@ -441,6 +639,57 @@ class MainActivity : Activity() {
         info = TextView(this).apply { id = R.id.info_text; hideWhenEmpty(this) }
         counters = TextView(this).apply { id = R.id.counters_text; textSize = 11f; hideWhenEmpty(this) }
         skyPlot = SkyPlotView(this).apply { id = R.id.sky_plot; visibility = View.GONE }
+        skyLegend = TextView(this).apply { id = R.id.sky_legend; text = SkyPlotView.legend(); visibility = View.GONE; textSize = 12f }
+        walkerPosition = TextView(this).apply { id = R.id.walker_position; textSize = 20f; setTypeface(typeface, android.graphics.Typeface.BOLD)
+            setTextColor(Color.BLACK); text = WalkerWords.position(Double.NaN) }
+        walkerSource = TextView(this).apply { id = R.id.walker_source; textSize = 15f; setTextColor(Color.BLACK); hideWhenEmpty(this) }
+        walkerHeading = TextView(this).apply { id = R.id.walker_heading; textSize = 15f; setTextColor(Color.BLACK); hideWhenEmpty(this) }
+        walkerWalked = TextView(this).apply { id = R.id.walker_walked; textSize = 15f; setTextColor(Color.BLACK); hideWhenEmpty(this) }
+        regionText = TextView(this).apply { id = R.id.region_text; textSize = 13f; hideWhenEmpty(this) }
+        val detailsHint = TextView(this).apply { id = R.id.details_hint; text = getString(R.string.details_hint); textSize = 12f; setTextColor(Color.GRAY) }
+        walkerPanel = LinearLayout(this).apply {
+            id = R.id.walker_panel
+            orientation = LinearLayout.VERTICAL
+            isClickable = true
+            setOnClickListener { toggleDetails() }
+            addView(LinearLayout(context).apply {
+                orientation = LinearLayout.HORIZONTAL
+                gravity = Gravity.CENTER_VERTICAL
+                addView(walkerPosition, LinearLayout.LayoutParams(0, -2, 1f))
+                addView(detailsHint)
+            })
+            addView(walkerSource)
+            addView(walkerHeading)
+            addView(walkerWalked)
+        }
+        detailsText = TextView(this).apply { id = R.id.details_text; textSize = 12f }
+        detailsPanel = LinearLayout(this).apply {
+            id = R.id.details_panel
+            orientation = LinearLayout.VERTICAL
+            visibility = View.GONE
+            addView(detailsText)
+            addView(counters)
+        }
+        gotoArrow = GoToArrowView(this).apply { id = R.id.goto_arrow }
+        gotoText = TextView(this).apply { id = R.id.goto_text; textSize = 14f; setTextColor(Color.BLACK) }
+        gotoPanel = LinearLayout(this).apply {
+            id = R.id.goto_panel
+            orientation = LinearLayout.HORIZONTAL
+            gravity = Gravity.CENTER_VERTICAL
+            visibility = View.GONE
+            addView(gotoArrow, LinearLayout.LayoutParams(Views.dp(context, 56), Views.dp(context, 56)))
+            addView(gotoText, LinearLayout.LayoutParams(0, -2, 1f).apply { leftMargin = Views.dp(context, 8) })
+            addView(Views.button(context, R.id.goto_stop, getString(R.string.goto_stop)) { goTo(null) },
+                LinearLayout.LayoutParams(-2, -2))
+        }
+        attribution = TextView(this).apply {
+            id = R.id.map_attribution
+            textSize = 10f
+            setTextColor(Color.DKGRAY)
+            setBackgroundColor(Color.argb(200, 255, 255, 255))
+            setPadding(pad / 2, 0, pad / 2, 0)
+            visibility = View.GONE
+        }
         locationPanel = LinearLayout(this).apply {
             id = R.id.location_panel
             orientation = LinearLayout.HORIZONTAL
@@ -464,24 +713,37 @@ class MainActivity : Activity() {
             orientation = LinearLayout.VERTICAL
             setBackgroundColor(Color.argb(210, 255, 255, 255))
             setPadding(pad * 2, pad, pad * 2, pad)
+            addView(walkerPanel)
+            addView(regionText)
+            addView(gotoPanel)
             addView(status)
             addView(info)
-            addView(counters)
+            addView(detailsPanel)
             addView(locationPanel)
             addView(interruptedPanel)
             addView(skyPlot, LinearLayout.LayoutParams(-1, Views.dp(context, 264)))
+            addView(skyLegend)
         }
         root.addView(top, FrameLayout.LayoutParams(-1, -2, Gravity.TOP))
 
         navigateButton = Views.button(this, R.id.button_navigate, getString(R.string.action_navigate)) { toggleNavigation() }
         recordButton = Views.button(this, R.id.button_record, getString(R.string.action_record)) { toggleRecording() }
         checkpointButton = Views.button(this, R.id.button_checkpoint, getString(R.string.action_checkpoint)) { askCheckpoint() }
+        detailsPanel.addView(checkpointButton, LinearLayout.LayoutParams(-2, -2))  // a tester's tool: with the details
         followButton = Views.button(this, R.id.button_follow, getString(R.string.action_follow_on)) {
             mapController.follow = !mapController.follow
             updateFollow()
         }
         val satButton = Views.button(this, R.id.button_satellites, getString(R.string.action_satellites)) {
             skyPlot.visibility = if (skyPlot.visibility == View.VISIBLE) View.GONE else View.VISIBLE
+            skyLegend.visibility = skyPlot.visibility
+        }
+        val savePlaceButton = Views.button(this, R.id.button_save_place, getString(R.string.action_save_place)) {
+            val here = service?.currentPosition()
+            if (here != null) askSavePlace(here[0], here[1]) else askSavePlace(mapController.centerLatDeg, mapController.centerLonDeg)
+        }
+        val placesButton = Views.button(this, R.id.button_places, getString(R.string.action_places)) {
+            startActivity(Intent(this, PlacesActivity::class.java).putExtra(PlacesActivity.EXTRA_REGION, currentRegionName() ?: ""))
         }
         val settingsButton = Views.button(this, R.id.button_settings, getString(R.string.action_settings)) {
             startActivity(Intent(this, SettingsActivity::class.java))
@@ -491,7 +753,8 @@ class MainActivity : Activity() {
         }
         val bottom = LinearLayout(this).apply {
             orientation = LinearLayout.VERTICAL
-            addView(Views.row(context, navigateButton, recordButton, checkpointButton))
+            addView(attribution, LinearLayout.LayoutParams(-2, -2))
+            addView(Views.row(context, navigateButton, recordButton, savePlaceButton, placesButton))
             addView(Views.row(context, followButton, satButton, settingsButton, sessionsButton))
         }
         root.addView(bottom, FrameLayout.LayoutParams(-1, -2, Gravity.BOTTOM))
@@ -521,6 +784,9 @@ class MainActivity : Activity() {
     companion object {
         const val REQUEST_PERMISSIONS = 1
         const val EXTRA_REPLAY = "org.pdnav.app.extra.REPLAY"
+        const val EXTRA_GOTO_NAME = "org.pdnav.app.extra.GOTO_NAME"
+        const val EXTRA_GOTO_LAT = "org.pdnav.app.extra.GOTO_LAT"
+        const val EXTRA_GOTO_LON = "org.pdnav.app.extra.GOTO_LON"
         private const val STATE_START = "pending_start"
         private const val STATE_ASKED = "permissions_asked"
     }

@@ -62,6 +62,10 @@ class SettingsActivity : Activity() {
         orientation = LinearLayout.VERTICAL
         val p = Views.dp(context, 16)
         setPadding(p, p, p, p)
+        // the walker's map data: one region file each (the single files below are for testers)
+        addView(Views.button(context, R.id.settings_regions, getString(R.string.settings_regions)) {
+            startActivity(Intent(this@SettingsActivity, RegionsActivity::class.java))
+        })
         heightField = number(R.id.settings_height, settings.heightM.toString(), true)
         female = CheckBox(this@SettingsActivity).apply {
             id = R.id.settings_female

@@ -130,6 +130,23 @@ class SkyPlotView(context: Context) : View(context) {
             else -> Color.BLACK
         }
 
+        /** The constellations the plot colours, in GnssStatus order (the legend). */
+        val LEGEND_CONSTELLATIONS = listOf(1, 3, 4, 5, 6, 7, 2)
+
+        /** Legend under the plot: "● GPS  ● GLONASS ...", each dot in its constellation's colour. */
+        fun legend(): CharSequence {
+            val b = android.text.SpannableStringBuilder()
+            for (c in LEGEND_CONSTELLATIONS) {
+                if (b.isNotEmpty()) b.append("  ")
+                val at = b.length
+                b.append("●")
+                b.setSpan(android.text.style.ForegroundColorSpan(constellationColor(c)), at, at + 1, android.text.Spanned.SPAN_EXCLUSIVE_EXCLUSIVE)
+                b.append("\u00A0").append(constellationName(c))  // the dot stays with its name
+            }
+            b.append("  (filled: used\u00A0in\u00A0the\u00A0fix)")
+            return b
+        }
+
         fun constellationName(c: Int): String = when (c) {
             1 -> "GPS"; 2 -> "SBAS"; 3 -> "GLONASS"; 4 -> "QZSS"; 5 -> "BeiDou"; 6 -> "Galileo"; 7 -> "IRNSS"
             else -> "?"
