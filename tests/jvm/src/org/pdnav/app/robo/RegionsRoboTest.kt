@@ -134,6 +134,8 @@ class RegionsRoboTest {
         assertEquals("Waiting for a first position", WalkerWords.source(null, true))
         assertEquals("±8 m, good", WalkerWords.position(8.2))
         assertEquals("±4 m, very good", WalkerWords.position(4.0))
+        assertEquals("±15 m, good", WalkerWords.position(15.3), "the word of the number shown")
+        assertEquals("±16 m, fair", WalkerWords.position(15.5))
         assertEquals("±120 m, poor", WalkerWords.position(120.0))
         assertEquals("±1.50 km, very poor", WalkerWords.position(1500.0))
         assertEquals("Facing north-east (47°)", WalkerWords.heading(Math.toRadians(47.0)))

@@ -41,6 +41,7 @@ import org.robolectric.shadows.ShadowSystemClock
 import java.io.File
 import java.io.IOException
 import java.time.Duration
+import kotlin.math.abs
 import kotlin.test.assertEquals
 import kotlin.test.assertFalse
 import kotlin.test.assertNotNull
@@ -453,10 +454,24 @@ class ServiceRoboTest {
             override fun onOutput(output: NavOutput, track: List<DoubleArray>) = Unit
             override fun onWalk(state: org.pdnav.app.walk.WalkState) { walks += state }
         })
+        // the state line: a hint while nothing runs and nothing is shown, then what happens
+        val stateView = screen.get().findViewById<android.widget.TextView>(org.pdnav.app.R.id.status_text)
+        val hints = listOf(app.getString(org.pdnav.app.R.string.status_idle), app.getString(org.pdnav.app.R.string.status_no_basemap))
+        assertTrue(stateView.text.toString() in hints, "no session, no walk: a hint (${stateView.text})")
         assertTrue(service.startReplay(log.path))
+        assertTrue(stateView.text.startsWith("Replaying ${log.name} ("), "while it runs: ${stateView.text}")
         val task = assertNotNull(service.replay)
         task.join(120_000)
         shadowOf(Looper.getMainLooper()).idle()
+        assertEquals(app.getString(org.pdnav.app.R.string.status_replay_done, log.name), stateView.text.toString(),
+            "the replayed walk is shown: its state, not the idle hint")
+        assertEquals(android.view.View.VISIBLE, stateView.visibility)
+        // the arrow on the map points where the heading text says (the latest step's heading)
+        val headingText = screen.get().findViewById<android.widget.TextView>(org.pdnav.app.R.id.walker_heading).text.toString()
+        val shownDeg = assertNotNull(Regex("\\((\\d+)°\\)").find(headingText), headingText).groupValues[1].toDouble()
+        val markerDeg = screen.get().map.markerHeadingDeg
+        assertTrue(abs(((markerDeg - shownDeg) % 360.0 + 540.0) % 360.0 - 180.0) <= 1.0,
+            "the arrow is turned to $markerDeg°, the screen says \"$headingText\"")
         assertEquals("Engolasters", service.region?.name, "the replay opened on the region containing its start")
         val g = assertNotNull(service.lastWalk?.goTo, "Go-to published")
         assertEquals("Hut", g.place.name)

@@ -134,6 +134,66 @@ class WalkerScreensRoboTest {
     private fun en(lat0: Double, lon0: Double, lat: Double, lon: Double) = doubleArrayOf(
         Math.toRadians(lon - lon0) * 6_371_000.0 * cos(Math.toRadians(lat0)), Math.toRadians(lat - lat0) * 6_371_000.0)
 
+    /** Difference of two bearings, degrees in [0, 180]. */
+    private fun angleDiff(a: Double, b: Double) = abs(((a - b) % 360.0 + 540.0) % 360.0 - 180.0)
+
+    /**
+     * The heading the screen says ("Facing south (158°)") against the arrow on the map: the
+     * marker's rotation (1° for the text's rounding) and the arrow as drawn (its pixels, the
+     * screen with and without the marker, matched against the app's arrow icon turned by each
+     * whole degree: the best match within 6°, the icon's outline being a few pixels wide).
+     */
+    private fun assertArrowAgreesWithHeading(activity: MainActivity, stepHeadingRad: Double, what: String) {
+        val headingText = text(activity, R.id.walker_heading)
+        val shownDeg = assertNotNull(Regex("\\((\\d+)°\\)").find(headingText), "$what: heading shown ($headingText)").groupValues[1].toDouble()
+        assertTrue(angleDiff(Math.toDegrees(stepHeadingRad), shownDeg) <= 0.5 + 1e-9, "$what: the text is the step's heading")
+        val markerDeg = activity.map.markerHeadingDeg
+        assertTrue(angleDiff(markerDeg, shownDeg) <= 1.0, "$what: the arrow is turned to $markerDeg°, the screen says \"$headingText\"")
+        val drawn = drawnArrowDeg(activity)
+        assertTrue(angleDiff(drawn, shownDeg) <= 6.0, "$what: the arrow is drawn pointing at $drawn°, the screen says \"$headingText\"")
+    }
+
+    private fun drawnArrowDeg(activity: MainActivity): Double {
+        idle()
+        val decor = activity.window.decorView
+        val mapView = activity.findViewById<MapView>(R.id.map_view)
+        val marker = activity.map.estimateMarker
+        assertTrue(marker.isEnabled, "the position's arrow is shown")
+        val with = BasemapFixture.snapshot(decor)
+        marker.isEnabled = false
+        val without = BasemapFixture.snapshot(decor)
+        marker.isEnabled = true
+        val loc = IntArray(2).also { mapView.getLocationInWindow(it) }
+        val c = mapView.projection.toPixels(marker.position, null)
+        val cx = c.x + loc[0]; val cy = c.y + loc[1]
+        val icon = org.pdnav.app.map.MapController.arrowBitmap(android.graphics.Color.BLACK, activity.resources.displayMetrics.density)
+        val drawnSize = marker.icon.intrinsicWidth.toDouble()  // the drawable's size on screen
+        val scale = icon.width / drawnSize
+        val reach = drawnSize.toInt()
+        val changed = ArrayList<DoubleArray>()
+        for (y in cy - reach..cy + reach) for (x in cx - reach..cx + reach) {
+            if (x !in 0 until with.width || y !in 0 until with.height) continue
+            if (with.getPixel(x, y) != without.getPixel(x, y)) changed += doubleArrayOf(x - cx + 0.5, y - cy + 0.5)
+        }
+        assertTrue(changed.size >= 100, "the arrow's pixels: ${changed.size}")
+        var best = -1
+        var bestHits = -1
+        for (deg in 0 until 360) {
+            val t = Math.toRadians(deg.toDouble())
+            val cs = cos(t); val sn = kotlin.math.sin(t)
+            var hits = 0
+            for (p in changed) {
+                // back into the upright icon: undo a clockwise turn by deg (screen y points down)
+                val ux = p[0] * cs + p[1] * sn
+                val uy = -p[0] * sn + p[1] * cs
+                val ix = (ux * scale + icon.width / 2.0).toInt(); val iy = (uy * scale + icon.height / 2.0).toInt()
+                if (ix in 0 until icon.width && iy in 0 until icon.height && android.graphics.Color.alpha(icon.getPixel(ix, iy)) > 0) hits++
+            }
+            if (hits > bestHits) { bestHits = hits; best = deg }
+        }
+        return best.toDouble()
+    }
+
     /** Distance (m) from a point to the nearest graph edge segment. */
     private fun toGraphM(edges: List<List<DoubleArray>>, lat: Double, lon: Double): Double {
         var best = Double.MAX_VALUE
@@ -181,12 +241,18 @@ class WalkerScreensRoboTest {
         val track = r.outs.filter { it.estimate.valid && it.estimate.latDeg.isFinite() }.map { doubleArrayOf(it.estimate.latDeg, it.estimate.lonDeg) }
         activity.mapDataThread?.join(20_000)
         idle()
+        // nothing runs and nothing is shown yet: the idle hint
+        assertEquals(activity.getString(R.string.status_idle), text(activity, R.id.status_text))
         activity.showOutput(last, track)
         activity.showWalk(w)
         val decor = activity.window.decorView
         val map = activity.findViewById<MapView>(R.id.map_view)
         val (pic, _) = pictureWithTiles(decor, map)
         BasemapFixture.save(pic, "main-walker")
+        // a walk is shown (no session runs): no idle hint under it
+        assertFalse(visibleText(decor).contains(activity.getString(R.string.status_idle)), "idle hint under a shown walk:\n${visibleText(decor)}")
+        assertEquals("", text(activity, R.id.status_text), "no session, a finished walk shown: no state line")
+        assertArrowAgreesWithHeading(activity, w.step!!.headingRad, "main screen")
         val attribution = activity.findViewById<TextView>(R.id.map_attribution)
         assertEquals(View.VISIBLE, attribution.visibility, "attribution shown")
         assertTrue(attribution.text.startsWith("© OpenStreetMap contributors"), "attribution: ${attribution.text}")
@@ -276,6 +342,8 @@ class WalkerScreensRoboTest {
         val mapView = activity.findViewById<MapView>(R.id.map_view)
         val (pic, mapRect) = pictureWithTiles(decor, mapView)
         BasemapFixture.save(pic, "goto")
+        assertArrowAgreesWithHeading(activity, w.step!!.headingRad, "go to")
+        assertFalse(visibleText(decor).contains(activity.getString(R.string.status_idle)), "idle hint under Go-to")
         assertEquals(View.VISIBLE, activity.findViewById<View>(R.id.goto_panel).visibility)
         val gt = text(activity, R.id.goto_text)
         assertTrue(gt.startsWith("Go to Hut: ") && gt.contains(" straight, bearing ") && gt.contains(" along paths"), gt)
@@ -339,22 +407,27 @@ class WalkerScreensRoboTest {
     @Test
     fun aWalkLeavingItsRegionIsToldAndNavigationGoesOn() {
         grantAll()
-        val full = installRegion()
-        // the same data declared for the southern part only: the walk (north, then back) leaves it
-        val dir = org.pdnav.app.nav.TestPaths.scratch("south-region")
-        val files = listOf("dem" to File(full.demPath), "graph" to File(full.graphPath), "basemap" to File(full.basemapPath))
-        val pack = RegionFixture.pack(File(dir, "South.pdnav-region"),
-            RegionFixture.manifest("Engolasters south", 42.5150, 1.5600, 42.5226, 1.5850, files), files.map { it.second })
-        val store = RegionStore(app.filesDir)
-        store.delete(full.name)
-        pack.inputStream().use { store.install(it, pack.name) }
+        // the real tool's pack for the southern part only: its DEM, walkways and basemap end at
+        // 42.5226 N, so north of it the core has neither terrain nor paths (the walk goes north,
+        // then back)
+        val pack = RegionFixture.build("Engolasters south", "--bbox", "42.5150,1.5600,42.5226,1.5850")
+        val south = RegionStore(app.filesDir).let { store -> pack.inputStream().use { store.install(it, pack.name) } }
+        assertTrue(south.bounds.northDeg < 42.5227, "south region bounds ${south.bounds}")
+        val demNorth = NativeBridge.demBounds(south.demPath)[2]
+        assertTrue(demNorth < 42.5226 + 0.0009, "the DEM ends within 100 m of the region's edge (at $demNorth)")
         val (_, log) = BasemapFixture.simulatedWalk()
         settings.engine = "auto"
         val r = replay(log, null)
         assertEquals("Engolasters south", r.task.region?.name)
         val k = r.pairs.indexOfFirst { it.second?.outsideRegion == true }
         assertTrue(k >= 0, "the walk left the region (north of 42.5226)")
-        val (outAt, walkAt) = r.pairs[k]
+        val leftAt = r.pairs[k].second!!.steps
+        // off the DEM the core drops the terrain engine: dead reckoning (its own fused estimate)
+        val j = (k until r.pairs.size).firstOrNull { r.pairs[it].second?.outsideRegion == true &&
+            r.pairs[it].first.estimate.engine == org.pdnav.app.nav.EngineKind.DEAD_RECKONING }
+        assertNotNull(j, "outside the region's DEM the core navigates on dead reckoning")
+        val (outAt, walkAt) = r.pairs[j]
+        assertTrue(walkAt!!.steps - leftAt <= 150, "dead reckoning ${walkAt.steps - leftAt} steps after leaving")
         val later = r.walks.last()
         assertTrue(later.steps > walkAt!!.steps + 100, "navigation went on: ${walkAt.steps} -> ${later.steps} steps")
         assertTrue(r.outs.last().estimate.valid, "a valid estimate at the end")
@@ -367,9 +440,15 @@ class WalkerScreensRoboTest {
         activity.showOutput(outAt, emptyList())
         activity.showWalk(walkAt)
         val decor = activity.window.decorView
+        // north of the region's map there are no tiles: a third of the map's picture at least
         val (pic, _) = pictureWithTiles(decor, activity.findViewById(R.id.map_view))
         BasemapFixture.save(pic, "out-of-region")
-        assertEquals("You have left the map area of Engolasters south: navigating on dead reckoning", text(activity, R.id.region_text))
+        // the fact, and the source the core uses: one story
+        assertEquals("You have left the map area of Engolasters south", text(activity, R.id.region_text))
+        assertEquals("Dead reckoning only", text(activity, R.id.walker_source))
+        val shown = visibleText(decor)
+        for (w in listOf("terrain", "paths", activity.getString(R.string.status_idle))) assertFalse(shown.contains(w), "\"$w\" out of the region:\n$shown")
+        assertArrowAgreesWithHeading(activity, walkAt.step!!.headingRad, "out of region")
         BasemapFixture.assertTextNotClipped(decor, pic, "out of region")
     }
 }

@@ -26,7 +26,8 @@ import kotlin.math.sin
 
 /**
  * The map screen's osmdroid view: offline MBTiles basemap only (never a network tile source),
- * the estimate as a marker anchored at the position with a heading arrow, its 95 % error
+ * the estimate as a marker anchored at the position with an arrow turned to the latest
+ * step's heading (the one the heading text says), its 95 % error
  * ellipse as a polygon, the track as a polyline, the phone's own GNSS fix with its accuracy
  * circle, every engine's estimate in its own colour and, optionally, the terrain engine's
  * particle cloud. The map opens on the basemap's area (or the last fix) and follows the
@@ -259,13 +260,44 @@ class MapController(context: Context, val map: MapView) {
         marker.position = here
         marker.snippet = e.statusText()
         marker.isEnabled = true
-        headingDeg(track)?.let { marker.rotation = -it.toFloat() }  // osmdroid rotates counter-clockwise
+        (if (stepHeadingDeg.isFinite()) stepHeadingDeg else headingDeg(track))?.let { setMarkerHeading(it) }
         ellipse.points = ellipsePoints(e)
         ellipse.isEnabled = true
         cloud.points = if (showParticles) particlePoints(e, out.particlesEnM) else emptyList()
         if (follow) map.controller.setCenter(here)
         map.invalidate()
     }
+
+    /**
+     * The walker's heading, degrees clockwise from true north: the latest step's (the core's
+     * calibrated walking direction, the one the heading text says). NaN before the first step;
+     * the arrow then follows the track's direction, if any.
+     */
+    private var stepHeadingDeg = Double.NaN
+
+    /** Turns the arrow to the latest step's heading [deg] (NaN: none yet, e.g. a new session). */
+    fun showHeading(deg: Double) {
+        stepHeadingDeg = deg
+        if (deg.isFinite()) {
+            setMarkerHeading(deg)
+            map.invalidate()
+        }
+    }
+
+    /**
+     * osmdroid draws a flat marker rotated by -rotation degrees (canvas degrees, clockwise on
+     * screen) in the map's frame (the canvas is already turned by the map's orientation), so a
+     * rotation of -heading points the arrow at that bearing from the map's north.
+     */
+    private fun setMarkerHeading(deg: Double) {
+        marker.rotation = -deg.toFloat()
+    }
+
+    /** The bearing the arrow points at on the map, degrees clockwise from north, [0, 360). */
+    val markerHeadingDeg: Double get() = ((-marker.rotation.toDouble()) % 360.0 + 360.0) % 360.0
+
+    /** The estimate's arrow (tests compare its picture with its heading). */
+    val estimateMarker: Marker get() = marker
 
     /** Engines drawn (valid positions of NavOutput.engines). */
     val engineCount: Int get() = engineDots.engines.size
@@ -293,8 +325,10 @@ class MapController(context: Context, val map: MapView) {
             Color.rgb(200, 30, 120), Color.rgb(120, 60, 200))
 
         /**
-         * Heading of travel, degrees clockwise from north, from the last track points at
-         * least 2 m apart (the navigator reports no heading); null while standing.
+         * Direction of travel, degrees clockwise from north, from the last track points at
+         * least 2 m apart; null while standing. Only until the first step's heading arrives
+         * ([showHeading]): the fused track bends with the filter's corrections, the step's
+         * heading is the walker's.
          */
         fun headingDeg(track: List<DoubleArray>): Double? {
             if (track.size < 2) return null

@@ -108,7 +108,7 @@ class MainActivity : Activity() {
     private val listener = object : NavigationService.Listener {
         override fun onOutput(output: NavOutput, track: List<DoubleArray>) = showOutput(output, track)
         override fun onError(message: String) {
-            status.text = getString(R.string.status_error, message)
+            errorShown = getString(R.string.status_error, message)
             updateButtons()
         }
         override fun onState() = updateButtons()
@@ -123,12 +123,7 @@ class MainActivity : Activity() {
         }
         override fun onReplay(output: NavOutput?, fraction: Double, done: Boolean, error: String?) {
             if (output != null) showOutput(output, emptyList())
-            val name = service?.replayPath?.let { File(it).name } ?: ""
-            status.text = when {
-                error != null -> getString(R.string.status_error, error)
-                done -> getString(R.string.status_replay_done, name) + (output?.let { " · " + it.estimate.statusText() } ?: "")
-                else -> getString(R.string.status_replaying, name, (fraction * 100).toInt())
-            }
+            updateStateLine()
             if (done) updateButtons()
         }
     }
@@ -140,7 +135,7 @@ class MainActivity : Activity() {
             s.addListener(listener)
             s.lastOutput?.let { showOutput(it, s.track) }
             s.lastStats?.let { showStats(it) }
-            s.lastError?.let { status.text = getString(R.string.status_error, it) }
+            s.lastError?.let { errorShown = getString(R.string.status_error, it) }
             s.region?.let { listener.onRegion(it) }
             s.lastWalk?.let { showWalk(it) }
             pendingGoTo?.let {
@@ -170,7 +165,7 @@ class MainActivity : Activity() {
         asked = savedInstanceState?.getBoolean(STATE_ASKED) ?: false
         mapController.setOnLongPress { p -> onMapLongPress(p.latitude, p.longitude) }
         mapController.onFollowChanged = { updateFollow() }
-        status.text = getString(R.string.status_idle)
+        updateStateLine()
         if (savedInstanceState?.getBoolean(STATE_ASKED) != true) ensurePermissions()
         pendingReplay = intent?.getStringExtra(EXTRA_REPLAY)
         goToFromIntent(intent)
@@ -192,10 +187,9 @@ class MainActivity : Activity() {
             shownRegion = null
             val basemap = settings.basemapPath.takeIf { it.isNotEmpty() }?.let(::File)
             val hasBasemap = mapController.loadBasemap(this, basemap)
-            if (!hasBasemap) {
-                status.text = getString(R.string.status_no_basemap)
-                centerOnLastFix()
-            }
+            noBasemap = !hasBasemap
+            updateStateLine()
+            if (!hasBasemap) centerOnLastFix()
             loadMapData(settings.graphPath, settings.demPath, centerOnDem = !hasBasemap)
             // the tester's single files: the basemap's own attribution, OSM's for its graph too
             showAttribution(if (hasBasemap) basemap?.let { MbtilesBounds.attribution(it) } else null,
@@ -238,6 +232,8 @@ class MainActivity : Activity() {
     fun showRegionMap(r: RegionInfo) {
         shownRegion = r
         val has = mapController.loadBasemap(this, File(r.basemapPath))
+        noBasemap = !has
+        updateStateLine()
         loadMapData(r.graphPath, r.demPath, centerOnDem = !has)
         showAttribution(r.attribution, osmShown = true)
         updateRegionMessage()
@@ -313,10 +309,12 @@ class MainActivity : Activity() {
     fun showWalk(w: WalkState) {
         lastWalk = w
         walkerHeading.text = w.step?.let { WalkerWords.heading(it.headingRad) } ?: ""
+        mapController.showHeading(w.step?.let { org.pdnav.app.walk.bearingDeg(it.headingRad) } ?: Double.NaN)  // the arrow says what the text says
         walkerWalked.text = if (w.steps > 0) WalkerWords.walked(w.distanceM, w.walkedNs) else ""
         w.step?.let { walkerPosition.text = WalkerWords.position(it.sigmaM) }
         updateRegionMessage()
         showGoTo(w.goTo)
+        updateStateLine()
     }
 
     private fun showGoTo(g: GoTo?) {
@@ -344,8 +342,7 @@ class MainActivity : Activity() {
         val r = w?.region ?: service?.region
         val outside = w != null && w.outsideRegion && r != null
         regionText.text = when {
-            outside -> getString(R.string.region_left, r!!.name,
-                if (lastOut?.estimate?.engine == org.pdnav.app.nav.EngineKind.GNSS) getString(R.string.region_left_gnss) else getString(R.string.region_left_dr))
+            outside -> getString(R.string.region_left, r!!.name)  // what the position comes from: the source line, from the core
             r != null -> getString(R.string.region_in, r.name)
             shownRegion != null -> getString(R.string.region_shown, shownRegion!!.name)
             else -> ""
@@ -562,6 +559,7 @@ class MainActivity : Activity() {
             getString(R.string.info_no_position)
         }
         detailsText.text = "${e.statusText()} · ${out.steps} steps\n$numbers"
+        updateStateLine()
     }
 
     /** Shows or hides the tester's details (one tap on the walker's panel). */
@@ -608,6 +606,51 @@ class MainActivity : Activity() {
         navigateButton.isEnabled = allowed && !replaying
         recordButton.isEnabled = allowed && !replaying
         checkpointButton.isEnabled = s?.session != null
+        updateStateLine()
+    }
+
+    /** A session's error, shown until the next session or replay starts. */
+    private var errorShown: String? = null
+    private var noBasemap = false
+    private var stateShown: String? = null
+
+    /**
+     * The state line under the walker's words: what the app is doing now (a session's error,
+     * a replay and its progress, navigating / recording), nothing while a finished walk is
+     * shown without a session, and the idle hint only when there is no session, no replay
+     * and no walk on the screen.
+     */
+    fun stateLine(): String {
+        val s = service
+        val rs = s?.replayState
+        val replayName = s?.replayPath?.let { File(it).name } ?: ""
+        val live = s?.session != null
+        return when {
+            errorShown != null -> errorShown!!
+            s?.replay != null -> getString(R.string.status_replaying, replayName, ((rs?.fraction ?: 0.0) * 100).toInt())
+            live && s!!.navigating && s.recording -> getString(R.string.state_navigating_recording)
+            live && s!!.navigating -> getString(R.string.state_navigating)
+            live && s!!.recording -> getString(R.string.state_recording_only)
+            live -> getString(R.string.state_starting)
+            rs != null && rs.done && rs.error != null -> getString(R.string.status_error, rs.error)
+            rs != null && rs.done -> getString(R.string.status_replay_done, replayName)
+            lastWalk?.step != null || lastOut?.estimate?.valid == true -> ""  // a walk is on the screen
+            noBasemap -> getString(R.string.status_no_basemap)
+            else -> getString(R.string.status_idle)
+        }
+    }
+
+    /**
+     * Shows [stateLine] when the state changed (a notice such as "place saved" stays until
+     * then).
+     */
+    private fun updateStateLine() {
+        val s = service
+        if (s?.session != null || s?.replay != null) errorShown = null  // a new session or replay
+        val line = stateLine()
+        if (line == stateShown) return
+        stateShown = line
+        status.text = line
     }
 
     private fun updateFollow() {
@@ -635,7 +678,7 @@ class MainActivity : Activity() {
         root.addView(map, FrameLayout.LayoutParams(-1, -1))
 
         val pad = Views.dp(this, 8)
-        status = TextView(this).apply { id = R.id.status_text }
+        status = TextView(this).apply { id = R.id.status_text; hideWhenEmpty(this) }
         info = TextView(this).apply { id = R.id.info_text; hideWhenEmpty(this) }
         counters = TextView(this).apply { id = R.id.counters_text; textSize = 11f; hideWhenEmpty(this) }
         skyPlot = SkyPlotView(this).apply { id = R.id.sky_plot; visibility = View.GONE }

@@ -27,9 +27,12 @@ object WalkerWords {
         else -> "very poor"
     }
 
-    /** e.g. "±8 m, good". */
-    fun position(sigmaM: Double): String =
-        if (!sigmaM.isFinite()) "No position yet" else "±${metres(sigmaM)}, ${quality(sigmaM)}"
+    /** e.g. "±8 m, good"; the word is that of the number shown ("±15 m" is good, not fair). */
+    fun position(sigmaM: Double): String {
+        if (!sigmaM.isFinite()) return "No position yet"
+        val shown = if (sigmaM < 999.5) sigmaM.roundToInt().toDouble() else sigmaM
+        return "±${metres(sigmaM)}, ${quality(shown)}"
+    }
 
     /** Where the shown position comes from, in words. [graphLoaded]: walkway graph in use. */
     fun source(out: NavOutput?, graphLoaded: Boolean): String {
