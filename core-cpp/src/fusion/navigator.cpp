@@ -617,7 +617,8 @@ struct Navigator::Impl {
       Eigen::Matrix2d r = e.cov_en_m2 * fo().aid_var_scale;
       r += fo().aid_min_sigma_m * fo().aid_min_sigma_m * Eigen::Matrix2d::Identity();
       const Eigen::Vector2d before = ff.position_en_m();
-      const PositionUpdateResult res = ff.update_position(t, z, r, /*use_gate_policy=*/false);
+      const PositionUpdateResult res = fo().aid_covariance_intersection ? ff.update_position_ci(t, z, r)
+                                                                         : ff.update_position(t, z, r, /*use_gate_policy=*/false);
       after_update(before);
       if (res.accepted) {
         *misses = 0;
@@ -776,6 +777,7 @@ NavigatorOutput Navigator::output(std::size_t max_particles) const {
   const std::size_t n = std::min(kModeChangesInOutput, impl_->changes.size());
   o.mode_changes.assign(impl_->changes.end() - static_cast<std::ptrdiff_t>(n), impl_->changes.end());
   o.calibration = impl_->applied;
+  o.calibration_fit = impl_->cal.calibration();
   o.declination_known = impl_->pdr.has_location();
   o.declination = impl_->pdr.declination();
   return o;

@@ -78,7 +78,24 @@ void PdrCalibrator::fit() {
   const double dof = std::max(1.0, 2.0 * n - 4.0);
   const double var_factor = std::max(1.0, chi2 / dof);
   const double span_s = static_cast<double>(window_.back().t_ns - window_.front().t_ns) * 1e-9;
-  const double n_eff = std::clamp(span_s / opt_.correlation_time_s + 1.0, 1.0, n);
+  // Effective number of independent epochs: GNSS errors (multipath, a chipset's own filter) and
+  // PDR drift make the residuals time-correlated. The smaller of span / correlation_time and
+  // the AR(1) value n (1 - rho) / (1 + rho) from the residuals' lag-1 autocorrelation rho
+  // (Bayley & Hammersley 1946), so a run of smoothed fixes is never counted as many.
+  double r0 = 0.0, r1 = 0.0;
+  std::complex<double> prev = 0.0;
+  bool have_prev = false;
+  for (const Pair& x : window_) {
+    const std::complex<double> e = x.g - g_mean - gain * (x.p - p_mean);
+    r0 += std::norm(e);
+    if (have_prev) r1 += std::real(std::conj(prev) * e);
+    prev = e;
+    have_prev = true;
+  }
+  const double rho = r0 > 0.0 ? std::clamp(r1 / r0, 0.0, 0.999) : 0.0;
+  c.residual_rho = rho;
+  const double n_eff_ar = n * (1.0 - rho) / (1.0 + rho);
+  const double n_eff = std::clamp(std::min(span_s / opt_.correlation_time_s + 1.0, n_eff_ar), 1.0, n);
   const double var_component = var_factor / spp * (n / n_eff);  // of Re c and of Im c
   c.scale = std::abs(gain);
   c.heading_bias_rad = std::arg(gain);

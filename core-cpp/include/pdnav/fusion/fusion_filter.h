@@ -48,6 +48,13 @@ struct FusionFilterOptions {
   /// position variance is kept >= this fraction of the measurement's, so a run of correlated
   /// fixes never claims they averaged out (beyond the paper; docs/fusion.md). 0 = off.
   double position_floor_fraction = 0.25;
+  /// Position measurements (SPP, the GNSS KF, chipset fixes, engine aiding) leave the heading
+  /// bias and scale states as consider states (Schmidt 1966; the Schmidt-Kalman filter): their
+  /// uncertainty enters the position covariance but a position update does not shrink or move
+  /// them. Their errors are correlated over minutes (multipath, a chipset's own filter), so a run
+  /// of fixes would "learn" a PDR scale and bias it does not know; the sliding-window calibrator
+  /// (with its effective sample size) and TDCP/Doppler displacements set them (docs/fusion.md).
+  bool consider_pdr_states_on_position = true;
 };
 
 struct PositionUpdateResult {
@@ -76,6 +83,12 @@ class FusionFilter {
   /// held epochs it may apply), e.g. 1 for an already-filtered, time-correlated measurement.
   PositionUpdateResult update_position(TimeNs t_ns, const Eigen::Vector2d& z_en_m, const Eigen::Matrix2d& r_m2,
                                        bool use_gate_policy = true, double floor_fraction = -1.0);
+  /// A position estimate whose error is correlated with the filter's by an unknown amount (an
+  /// aiding engine driven by the same PDR steps): covariance intersection on the position block
+  /// (Julier & Uhlmann 1997): with w in (0, 1] minimising det of the fused position covariance,
+  /// the position rows/columns of P are scaled by 1/sqrt(w) and R by 1/(1 - w) before a Kalman
+  /// update, which stays consistent for any cross-correlation. Gated at gate_chi2 on P_pos + R.
+  PositionUpdateResult update_position_ci(TimeNs t_ns, const Eigen::Vector2d& z_en_m, const Eigen::Matrix2d& r_m2);
   /// Displacement since the clone (the last GNSS epoch), e.g. TDCP. Returns accepted.
   bool update_displacement(TimeNs t_ns, TimeNs from_ns, const Eigen::Vector2d& d_en_m, const Eigen::Matrix2d& r_m2,
                            double* nis = nullptr);

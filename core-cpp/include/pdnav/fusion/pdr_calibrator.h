@@ -23,8 +23,11 @@ struct PdrCalibrationOptions {
   double min_baseline_m = 20.0;       // RMS spread of the PDR track in the window before publishing
   int min_epochs = 20;                // GNSS epochs in the window before publishing
   double correlation_time_s = 10.0;   // GNSS error correlation (multipath): N_eff = span / this
-  double max_scale_sigma = 0.03;      // publish only when the scale is known to 3 %
-  double max_heading_bias_sigma_rad = 4.0 * kDegToRad;  // ... and the bias to 4 deg
+  /// Published when it knows the scale and the heading bias at least twice as well as the
+  /// fused filter's prior (10 %, 10 deg: FusionFilterOptions); the filter then carries the fit's
+  /// own sigmas, so a less certain calibration is used with its honest uncertainty.
+  double max_scale_sigma = 0.05;
+  double max_heading_bias_sigma_rad = 5.0 * kDegToRad;
   double min_scale = 0.5, max_scale = 1.8;  // a fit outside is not a calibration (wrong data)
   std::size_t max_steps_kept = 4096;  // bound on the step history (memory)
 };
@@ -38,6 +41,7 @@ struct PdrCalibration {
   double heading_bias_sigma_rad = 0.0;
   int epochs = 0;                     // GNSS epochs in the window
   double baseline_m = 0.0;            // RMS spread of the PDR track in the window
+  double residual_rho = 0.0;          // lag-1 autocorrelation of the fit residuals (N_eff)
 };
 
 class PdrCalibrator {
