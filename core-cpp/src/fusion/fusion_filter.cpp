@@ -69,6 +69,14 @@ void FusionFilter::advance_to(TimeNs t_ns) {
     p_(1, 1) += opt_.undetected_motion_q_m2ps * dt;
   }
   const double dt_all = static_cast<double>(t_ns - t_ns_) * 1e-9;
+  if (opt_.heading_bias_tau_s > 0.0 && heading_stationary_var_ > 0.0) {
+    // first-order Gauss-Markov heading bias: decays towards 0, variance towards the stated one
+    const double phi = std::exp(-dt_all / opt_.heading_bias_tau_s);
+    x_(2) *= phi;
+    for (int i = 0; i < 6; ++i)
+      if (i != 2) p_(2, i) *= phi, p_(i, 2) *= phi;
+    p_(2, 2) = phi * phi * p_(2, 2) + heading_stationary_var_ * (1.0 - phi * phi);
+  }
   p_(2, 2) += opt_.heading_bias_rw_rad2ps * dt_all;
   p_(3, 3) += opt_.scale_rw_1ps * dt_all;
   t_ns_ = t_ns;
@@ -76,6 +84,9 @@ void FusionFilter::advance_to(TimeNs t_ns) {
 
 void FusionFilter::predict(const PdrStep& s) {
   if (!initialized_ || !std::isfinite(s.length_m) || !std::isfinite(s.heading_rad)) return;
+  const bool gm = opt_.heading_bias_tau_s > 0.0;
+  if (gm && std::isfinite(s.heading_sigma_rad) && s.heading_sigma_rad > 0.0)
+    heading_stationary_var_ = std::min(kPi, s.heading_sigma_rad) * std::min(kPi, s.heading_sigma_rad);
   advance_to(s.t_ns);
   const double psi = s.heading_rad - x_(2);
   const double len = (1.0 + x_(3)) * s.length_m;
@@ -87,8 +98,8 @@ void FusionFilter::predict(const PdrStep& s) {
   f(0, 3) = s.length_m * sp;
   f(1, 3) = s.length_m * cp;
   const double sl = std::max(opt_.min_step_length_sigma_m, std::isfinite(s.length_sigma_m) ? s.length_sigma_m : 0.0);
-  const double sh = std::max(opt_.min_step_heading_sigma_rad,
-                             std::isfinite(s.heading_sigma_rad) ? s.heading_sigma_rad : 0.0);
+  const double sh = gm ? opt_.min_step_heading_sigma_rad
+                      : std::max(opt_.min_step_heading_sigma_rad, std::isfinite(s.heading_sigma_rad) ? s.heading_sigma_rad : 0.0);
   Eigen::Matrix2d g;
   g << sp, len * cp, cp, -len * sp;
   const Eigen::Matrix2d q = g * Eigen::Vector2d(sl * sl, sh * sh).asDiagonal() * g.transpose();

@@ -94,7 +94,7 @@ void PdrCalibrator::fit() {
   }
   const double rho = r0 > 0.0 ? std::clamp(r1 / r0, 0.0, 0.999) : 0.0;
   c.residual_rho = rho;
-  const double n_eff_ar = n * (1.0 - rho) / (1.0 + rho);
+  const double n_eff_ar = opt_.residual_correlation ? n * (1.0 - rho) / (1.0 + rho) : n;
   const double n_eff = std::clamp(std::min(span_s / opt_.correlation_time_s + 1.0, n_eff_ar), 1.0, n);
   const double var_component = var_factor / spp * (n / n_eff);  // of Re c and of Im c
   c.scale = std::abs(gain);

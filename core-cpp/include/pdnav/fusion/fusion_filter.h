@@ -30,6 +30,14 @@ struct FusionFilterOptions {
   double heading_bias_rw_rad2ps = (2.0 * kDegToRad) * (2.0 * kDegToRad) / 60.0;
   /// Random walk of the residual step scale (pace changes): (1 %)^2 per minute.
   double scale_rw_1ps = 1e-4 / 60.0;
+  /// The PDR's stated heading 1-sigma (PdrStep::heading_sigma_rad: compass / rotation vector
+  /// accuracy) is the sigma of a slowly varying error (magnetic disturbances along the way, gyro
+  /// drift), not of independent per-step noise: the heading bias state is a first-order
+  /// Gauss-Markov process with that stationary sigma and this correlation time (Gelb 1974,
+  /// Sec. 3.8), taken as the calibration window (the span over which the calibrator assumes the
+  /// bias constant). Each step then keeps only min_step_heading_sigma_rad as white noise.
+  /// 0 = the stated sigma is white per-step noise (the model before issue 28).
+  double heading_bias_tau_s = 300.0;
   double min_step_heading_sigma_rad = 3.0 * kDegToRad;  // floor of a step's white heading noise
   double min_step_length_sigma_m = 0.05;                // floor of a step's white length noise
   /// Motion no step reported (shuffling, a missed detection): position random walk, m^2/s,
@@ -123,6 +131,7 @@ class FusionFilter {
   Vec6 x_ = Vec6::Zero();
   Mat6 p_ = Mat6::Identity();
   TimeNs t_ns_ = 0;
+  double heading_stationary_var_ = -1.0;  // the PDR's stated heading variance (last step), < 0 unknown
   TimeNs last_step_ns_ = -1;
   TimeNs last_accept_ns_ = -1;
   bool clone_ok_ = false;

@@ -22,7 +22,8 @@ struct PdrCalibrationOptions {
   double window_s = 300.0;            // Walker 2019 Sec. 3: sliding window (5 min here)
   double min_baseline_m = 20.0;       // RMS spread of the PDR track in the window before publishing
   int min_epochs = 20;                // GNSS epochs in the window before publishing
-  double correlation_time_s = 10.0;   // GNSS error correlation (multipath): N_eff = span / this
+  double correlation_time_s = 10.0;   // GNSS error correlation (multipath): N_eff <= span / this
+  bool residual_correlation = true;   // N_eff also <= the AR(1) value of the residuals (pdr_calibrator.cpp)
   /// Published when it knows the scale and the heading bias at least twice as well as the
   /// fused filter's prior (10 %, 10 deg: FusionFilterOptions); the filter then carries the fit's
   /// own sigmas, so a less certain calibration is used with its honest uncertainty.
