@@ -30,6 +30,7 @@
 #include "pdnav/geo/frames.h"
 #include "pdnav/geo/wmm.h"
 #include "pdnav/io/log_reader.h"
+#include "pdnav/io/sample_source.h"
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/phonesim/handling.h"
 
@@ -274,7 +275,8 @@ double segment_heading_error_deg(const Eigen::Vector2d& truth_en, const Eigen::V
 }
 
 std::vector<Sample> read_samples(const std::string& path) {
-  io::LogReader reader(path);
+  const std::unique_ptr<io::SampleSource> source = io::open_sample_source(path);  // any format
+  io::SampleSource& reader = *source;
   std::vector<Sample> out;
   Sample s;
   while (reader.next(s)) out.push_back(s);

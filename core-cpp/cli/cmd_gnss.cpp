@@ -6,6 +6,8 @@
 // (nan where there is no truth or no data; D = worst axis RMS of the 1 s TDCP displacement).
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -23,12 +25,15 @@
 #include "pdnav/gnss/solver_metrics.h"
 #include "pdnav/gnss/sp3.h"
 #include "pdnav/io/log_reader.h"
+#include "pdnav/io/sample_source.h"
+#include "support/sources.h"
 
 namespace pdnav::cli {
 namespace {
 
 struct GnssArgs {
   std::string log;
+  std::string format = "auto";
   std::vector<std::string> nav;
   std::vector<std::string> sp3;
   std::vector<std::string> clk;
@@ -83,6 +88,7 @@ enum class InputFormat { kLog, kRinexObs };
 /// GnssLogger / pdnav session log or RINEX 3 observations, decided from the content; any
 /// other file is an error with the reason.
 InputFormat detect_format(const std::string& path) {
+  if (std::filesystem::is_directory(path)) return InputFormat::kLog;  // a Sensor Logger / phyphox folder
   std::ifstream f(path);
   if (!f) throw std::runtime_error(path + ":0: cannot open");
   std::string l;
@@ -101,6 +107,11 @@ InputFormat detect_format(const std::string& path) {
     static const char* kTypes[] = {"Raw", "Fix", "Nav", "Status", "Accel", "Gyro", "Mag", "UncalAccel", "UncalGyro",
                                    "UncalMag", "OrientationDeg", "Agc", "Pressure", "Truth", "Step", "GameRot"};
     for (const char* t : kTypes) if (type == t) return InputFormat::kLog;
+    try {
+      (void)io::detect_format(path);  // another recording format (its reader reports what it lacks)
+      return InputFormat::kLog;
+    } catch (const io::IoError&) {
+    }
     throw std::runtime_error(path + ":" + std::to_string(n) +
                              ": neither a GnssLogger/session log (no '#' header or known line type) nor a RINEX "
                              "observation file (no RINEX VERSION / TYPE line)");
@@ -114,13 +125,14 @@ void strip(GnssRawSample& raw) {
 }
 
 /// Runs the whole input through the engine; returns every epoch solution.
-std::vector<gnss::EpochSolution> run(const GnssArgs& a, gnss::GnssEngine& engine, std::int64_t& raw_rows) {
+std::vector<gnss::EpochSolution> run(const GnssArgs& a, gnss::GnssEngine& engine, std::int64_t& raw_rows,
+                                     std::int64_t& nav_rows) {
   std::vector<gnss::EpochSolution> sols;
   auto collect = [&]() {
     auto part = engine.take_solutions();
     sols.insert(sols.end(), part.begin(), part.end());
   };
-  if (detect_format(a.log) == InputFormat::kRinexObs) {
+  if (a.format == "auto" && detect_format(a.log) == InputFormat::kRinexObs) {
     std::ifstream f(a.log);
     gnss::RinexObsReader reader(f, a.log);
     gnss::RinexObsEpoch ep;
@@ -149,7 +161,8 @@ std::vector<gnss::EpochSolution> run(const GnssArgs& a, gnss::GnssEngine& engine
     if (rep.epochs == 0) throw std::runtime_error(a.log + ": RINEX observation file without any epoch");
     return sols;
   }
-  io::LogReader reader(a.log);
+  const std::unique_ptr<io::SampleSource> source = open_source(a.log, a.format);
+  io::SampleSource& reader = *source;
   Sample s;
   std::int64_t index = -1, last_time_nanos = kMissingInt;
   while (reader.next(s)) {
@@ -162,6 +175,7 @@ std::vector<gnss::EpochSolution> run(const GnssArgs& a, gnss::GnssEngine& engine
       if (a.strip_adr) strip(*raw);
       engine.feed(*raw);
     } else if (const auto* nav = std::get_if<NavMessageSample>(&s)) {
+      ++nav_rows;
       engine.feed(*nav);
     }
     collect();
@@ -322,8 +336,13 @@ void run_gnss(const GnssArgs& a) {
   options.spp.robust_igg3 = a.spp_igg3;
   options.record_code_observations = !a.residuals_out.empty();
   gnss::GnssEngine engine(options, store, a.seed);
-  std::int64_t raw_rows = 0;
-  const std::vector<gnss::EpochSolution> sols = run(a, engine, raw_rows);
+  std::int64_t raw_rows = 0, nav_rows = 0;
+  const std::vector<gnss::EpochSolution> sols = run(a, engine, raw_rows, nav_rows);
+  if (a.nav.empty() && a.sp3.empty() && nav_rows == 0 &&
+      std::none_of(sols.begin(), sols.end(), [](const gnss::EpochSolution& s) { return s.spp_ok; }))
+    throw std::runtime_error(a.log + ": " + std::to_string(raw_rows) +
+                             " Raw rows but no satellite orbits: pass the broadcast ephemeris with --nav FILE "
+                             "(RINEX navigation) or use a log that records Nav rows");
   print_summary(sols, engine, raw_rows);
   const bool have_truth = !a.truth.empty();
   geo::Geodetic truth;
@@ -363,7 +382,8 @@ void run_gnss(const GnssArgs& a) {
 void register_gnss(CLI::App& app) {
   auto args = std::make_shared<GnssArgs>();
   CLI::App* cmd = app.add_subcommand("gnss", "GNSS engine (SPP, TDCP, robust KF; Walker 2019) on a log's Raw rows");
-  cmd->add_option("log", args->log, "GnssLogger / session log or RINEX 3.0x observation file (detected from the content)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("log", args->log, "GnssLogger / session log or RINEX 3.0x observation file (detected from the content)")->required()->check(CLI::ExistingPath);
+  add_format_option(cmd, args->format);
   cmd->add_option("--nav", args->nav, "RINEX navigation files (2 or 3)")->check(CLI::ExistingFile);
   cmd->add_option("--sp3", args->sp3, "precise orbits and clocks (SP3-c/d); used instead of broadcast where they cover")
       ->check(CLI::ExistingFile);

@@ -10,6 +10,8 @@
 
 #include "pdnav/io/log_format.h"
 #include "pdnav/io/log_reader.h"
+#include "pdnav/io/sample_source.h"
+#include "support/sources.h"
 
 namespace pdnav::cli {
 namespace {
@@ -22,6 +24,7 @@ struct TypeSummary {
 
 struct InspectArgs {
   std::string path;
+  std::string format = "auto";
   bool strict = false;
   std::size_t issues = 5;
 };
@@ -77,11 +80,13 @@ void print_skips(const io::ReadStats& st, std::size_t max_issues) {
 }
 
 void run_inspect(const InspectArgs& a) {
-  io::LogReaderOptions opt;
-  opt.strict = a.strict;
-  io::LogReader reader(a.path, opt);
+  io::SourceOptions opt;
+  opt.log.strict = a.strict;
+  const std::unique_ptr<io::SampleSource> source = open_source(a.path, a.format, opt);
+  io::SampleSource& reader = *source;
   std::error_code ec;
-  const auto size = std::filesystem::file_size(a.path, ec);
+  const bool folder = std::filesystem::is_directory(a.path, ec);
+  const auto size = folder ? 0 : std::filesystem::file_size(a.path, ec);
   Progress progress(!ec && size > (32u << 20));
   std::map<std::string, TypeSummary> types;
   bool any = false;
@@ -102,7 +107,12 @@ void run_inspect(const InspectArgs& a) {
   }
   progress.done();
   const io::ReadStats& st = reader.stats();
-  std::printf("file: %s (%llu bytes)\n", a.path.c_str(), ec ? 0ull : static_cast<unsigned long long>(size));
+  if (folder) std::printf("folder: %s (%s)\n", a.path.c_str(), std::string(io::format_name(reader.format())).c_str());
+  else if (reader.format() == io::Format::kSession || reader.format() == io::Format::kGnssLogger)
+    std::printf("file: %s (%llu bytes)\n", a.path.c_str(), ec ? 0ull : static_cast<unsigned long long>(size));
+  else
+    std::printf("file: %s (%llu bytes, %s)\n", a.path.c_str(), ec ? 0ull : static_cast<unsigned long long>(size),
+                std::string(io::format_name(reader.format())).c_str());
   std::printf("header:");
   for (const auto& [k, v] : reader.header_info()) std::printf(" %s=%s;", k.c_str(), v.c_str());
   std::printf("\nlines: %lld\n", static_cast<long long>(st.lines));
@@ -111,6 +121,7 @@ void run_inspect(const InspectArgs& a) {
     std::printf("time span: %.6f s .. %.6f s (%.3f s)\n", static_cast<double>(t_min) * 1e-9,
                 static_cast<double>(t_max) * 1e-9, static_cast<double>(t_max - t_min) * 1e-9);
   print_skips(st, a.issues);
+  for (const auto& [what, why] : st.not_used) std::printf("not used: %s: %s\n", what.c_str(), why.c_str());
   std::printf("samples: %lld skipped: %lld\n", static_cast<long long>(st.samples),
               static_cast<long long>(st.skipped_total()));
 }
@@ -120,9 +131,12 @@ void run_inspect(const InspectArgs& a) {
 void register_inspect(CLI::App& app) {
   auto args = std::make_shared<InspectArgs>();
   CLI::App* sub = app.add_subcommand(
-      "inspect", "Summarise a session log or GnssLogger log: header, samples per line type, "
+      "inspect", "Summarise a recording (session log, GnssLogger, Sensor Logger, phyphox, GetSensorData): header, samples per line type, "
                  "time span, rates, skipped lines by reason");
-  sub->add_option("log", args->path, "log file (pdnav session log or GnssLogger .txt)")->required();
+  sub->add_option("log", args->path,
+                  "log file (pdnav session log or GnssLogger .txt), Sensor Logger / phyphox export (folder or zip), "
+                  "GetSensorData log")->required();
+  add_format_option(sub, args->format);
   sub->add_flag("--strict", args->strict, "stop with an error at the first malformed line");
   sub->add_option("--issues", args->issues, "how many skipped lines to list (default 5)");
   sub->callback([args] { run_inspect(*args); });

@@ -13,15 +13,17 @@
 #include <nlohmann/json.hpp>
 
 #include "pdnav/fusion/navigator.h"
-#include "pdnav/io/log_reader.h"
+#include "pdnav/io/sample_source.h"
 #include "pdnav/pdr/pdr.h"
 #include "support/replay_support.h"
+#include "support/sources.h"
 
 namespace pdnav::cli {
 namespace {
 
 struct ReplayArgs {
   std::string log;
+  std::string format = "auto";
   std::string out_dir;
   std::string engine = "auto";
   std::string dem;
@@ -87,7 +89,8 @@ nlohmann::json fusion_summary(const fusion::Navigator& nav) {
 int run_replay(const ReplayArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   std::filesystem::create_directories(a.out_dir);
-  io::LogReader reader(a.log);
+  const std::unique_ptr<io::SampleSource> source = open_source(a.log, a.format);
+  io::SampleSource& reader = *source;
   const fusion::NavigatorConfig config = make_config(a);
   fusion::Navigator nav(config, a.seed);
   // A PDR twin with the Navigator's placement options, for the summary's placements/distance.
@@ -136,6 +139,7 @@ int run_replay(const ReplayArgs& a) {
   rec.write_geojson((out / "track.geojson").string());
   nlohmann::json summary;
   summary["log"] = a.log;
+  summary["format"] = std::string(io::format_name(reader.format()));
   summary["engine_mode"] = a.engine;
   summary["seed"] = a.seed;
   summary["run_time_s"] = run_s;
@@ -143,6 +147,7 @@ int run_replay(const ReplayArgs& a) {
   summary["samples"] = reader.stats().samples;
   summary["samples_by_type"] = reader.stats().samples_by_type;
   summary["skipped_lines_by_reason"] = reader.stats().skipped_by_reason;
+  summary["not_used"] = reader.stats().not_used;
   nlohmann::json issues = nlohmann::json::array();
   for (const auto& i : reader.stats().issues) issues.push_back(i.to_string());
   summary["first_issues"] = issues;
@@ -161,10 +166,11 @@ int run_replay(const ReplayArgs& a) {
                             {"model", o.declination.model}, {"warning", o.declination.warning}};
   std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
 
-  std::cout << "log:      " << a.log << "\n"
+  std::cout << "log:      " << a.log << " (" << io::format_name(reader.format()) << ")\n"
             << "samples:  " << reader.stats().samples << " (skipped lines: " << reader.stats().skipped_total() << ")\n";
   for (const auto& [type, n] : reader.stats().samples_by_type) std::cout << "  " << type << ": " << n << "\n";
   for (const auto& [why, n] : reader.stats().skipped_by_reason) std::cout << "  skipped " << n << ": " << why << "\n";
+  print_not_used(std::cout, reader.stats());
   std::cout << "epochs:   " << rec.epochs().size() << "\n";
   std::cout << "mode changes: " << nav.output(0).mode_change_count << " (summary.json fusion.mode_changes)\n";
   for (const auto& [eng, n] : rec.epochs_by_engine()) std::cout << "  " << eng << ": " << n << "\n";
@@ -186,7 +192,8 @@ int run_replay(const ReplayArgs& a) {
 void register_replay(CLI::App& app) {
   auto a = std::make_shared<ReplayArgs>();
   CLI::App* c = app.add_subcommand("replay", "Replay a session log through the core; write track, GeoJSON, summary");
-  c->add_option("log", a->log, "session log (pdnav or GnssLogger format)")->required()->check(CLI::ExistingFile);
+  c->add_option("log", a->log, "session log (pdnav or GnssLogger), Sensor Logger / phyphox export (folder or zip), GetSensorData log")->required()->check(CLI::ExistingPath);
+  add_format_option(c, a->format);
   c->add_option("--out", a->out_dir, "output directory")->required();
   c->add_option("--engine", a->engine, "auto | dr | terrain | route | gnss")->capture_default_str();
   c->add_option("--dem", a->dem, "DEM tile (.pdem from dem-tools) for the terrain engine")->check(CLI::ExistingFile);

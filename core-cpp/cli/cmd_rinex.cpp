@@ -12,18 +12,21 @@
 #include <CLI/CLI.hpp>
 
 #include "pdnav/gnss/rinex_obs.h"
-#include "pdnav/io/log_reader.h"
+#include "pdnav/io/sample_source.h"
+#include "support/sources.h"
 
 namespace pdnav::cli {
 namespace {
 
 struct RinexArgs {
   std::string log;
+  std::string format = "auto";
   std::string out;
 };
 
 void run_rinex(const RinexArgs& a) {
-  io::LogReader reader(a.log);
+  const std::unique_ptr<io::SampleSource> source = open_source(a.log, a.format);
+  io::SampleSource& reader = *source;
   gnss::RinexObsWriter writer("pdnav rinex");
   std::map<std::string, std::int64_t> skipped;
   std::int64_t raw = 0, written = 0;
@@ -53,7 +56,8 @@ void run_rinex(const RinexArgs& a) {
 void register_rinex(CLI::App& app) {
   auto args = std::make_shared<RinexArgs>();
   CLI::App* cmd = app.add_subcommand("rinex", "write a GnssLogger / session log's Raw rows as RINEX 3.04 observations");
-  cmd->add_option("log", args->log, "GnssLogger or pdnav session log")->required()->check(CLI::ExistingFile);
+  cmd->add_option("log", args->log, "GnssLogger or pdnav session log (or any recording with Raw rows)")->required()->check(CLI::ExistingPath);
+  add_format_option(cmd, args->format);
   cmd->add_option("-o,--out", args->out, "output RINEX observation file")->required();
   cmd->callback([args]() { run_rinex(*args); });
 }

@@ -19,6 +19,7 @@
 
 #include "pdnav/geo/wmm.h"
 #include "pdnav/io/log_reader.h"
+#include "pdnav/io/sample_source.h"
 #include "pdnav/pdr/pdr.h"
 #include "support/pdr_oxford.h"
 
@@ -129,7 +130,9 @@ void feed_sample(pdr::Pdr& engine, const Sample& s) {
 }
 
 FileResult run_log(const std::string& path, const pdr::PdrOptions& options) {
-  io::LogReader reader(path);
+  // any recording pdnav reads (session, GnssLogger, Sensor Logger, phyphox, GetSensorData)
+  const std::unique_ptr<io::SampleSource> source = io::open_sample_source(path);
+  io::SampleSource& reader = *source;
   pdr::Pdr engine(options);
   FileResult r;
   r.file = path;

@@ -33,6 +33,11 @@ if(NOT TARGET FastFloat::fast_float)
   target_include_directories(FastFloat::fast_float INTERFACE "${fast_float_SOURCE_DIR}/include")
 endif()
 
+# zlib: inflate for zipped recordings (Sensor Logger, phyphox exports; io/container.cpp).
+# A system library of the Android NDK (libz.so in every sysroot) and Debian's zlib1g-dev on
+# the host, so the same find_package works on both.
+find_package(ZLIB REQUIRED)
+
 if(NOT ANDROID)
   # Host-only tools (CLI, tests, benchmarks).
   find_package(CLI11 2.1 REQUIRED CONFIG)

@@ -11,6 +11,7 @@
 #include "jni_support.h"
 #include "pdnav/fusion/navigator.h"
 #include "pdnav/io/log_reader.h"
+#include "pdnav/io/sample_source.h"
 #include "pdnav/io/log_writer.h"
 #include "pdnav/route/walk_graph.h"
 #include "pdnav/terrain/dem.h"
@@ -21,7 +22,7 @@ namespace {
 
 using NavHandle = Handle<fusion::Navigator>;
 using RecHandle = Handle<io::LogWriter>;
-using ReaderHandle = Handle<io::LogReader>;
+using ReaderHandle = Handle<std::unique_ptr<io::SampleSource>>;
 
 constexpr const char* kBridgeClass = "org/pdnav/app/nav/NativeBridge";
 constexpr const char* kEstimateClass = "org/pdnav/app/nav/NavEstimate";
@@ -320,18 +321,26 @@ void rec_close(JNIEnv* env, jclass, jlong handle) {
   });
 }
 
-// ---- log reader (io::LogReader) -------------------------------------------------------
+// ---- log reader (io::open_sample_source: session/GnssLogger log, Sensor Logger or phyphox
+// folder/zip, GetSensorData file; the format from the content) ------------------------------
+
+/// The app's replay shows an empty recording as empty (stats tell why); the CLI refuses it.
+io::SourceOptions reader_options() {
+  io::SourceOptions o;
+  o.require_samples = false;
+  return o;
+}
 
 jlong reader_open(JNIEnv* env, jclass, jstring path) {
   return guarded<jlong>(env, 0, [&] {
-    return to_handle(new ReaderHandle(to_string(env, path, "path")));
+    return to_handle(new ReaderHandle(io::open_sample_source(to_string(env, path, "path"), io::Format::kAuto, reader_options())));
   });
 }
 
 jint reader_read(JNIEnv* env, jclass, jlong handle, jint max, jintArray k, jlongArray t,
                  jlongArray i, jdoubleArray d, jobjectArray s, jbyteArray b) {
   return guarded<jint>(env, 0, [&] {
-    auto& h = from_handle<io::LogReader>(handle, "NativeLogReader");
+    auto& h = from_handle<std::unique_ptr<io::SampleSource>>(handle, "NativeLogReader");
     if (max <= 0) throw JavaError(kIllegalArgument, "max must be > 0");
     const JavaBatchArrays a = arrays(k, t, i, d, s, b);
     check_batch_arrays(env, static_cast<std::size_t>(max), a);
@@ -340,7 +349,7 @@ jint reader_read(JNIEnv* env, jclass, jlong handle, jint max, jintArray k, jlong
     {
       const std::lock_guard<std::mutex> lock(h.mutex);
       Sample sample;
-      while (n < static_cast<std::size_t>(max) && h.object.next(sample)) {
+      while (n < static_cast<std::size_t>(max) && h.object->next(sample)) {
         encode_row(sample, out.rows(), n);
         ++n;
       }
@@ -352,9 +361,9 @@ jint reader_read(JNIEnv* env, jclass, jlong handle, jint max, jintArray k, jlong
 
 jlongArray reader_stats(JNIEnv* env, jclass, jlong handle) {
   return guarded<jlongArray>(env, nullptr, [&] {
-    auto& h = from_handle<io::LogReader>(handle, "NativeLogReader");
+    auto& h = from_handle<std::unique_ptr<io::SampleSource>>(handle, "NativeLogReader");
     const std::lock_guard<std::mutex> lock(h.mutex);
-    const auto& st = h.object.stats();
+    const auto& st = h.object->stats();
     const jlong v[] = {st.lines, st.samples, st.skipped_total()};
     jlongArray a = env->NewLongArray(3);
     env->SetLongArrayRegion(a, 0, 3, v);
@@ -364,15 +373,15 @@ jlongArray reader_stats(JNIEnv* env, jclass, jlong handle) {
 
 jdouble reader_progress(JNIEnv* env, jclass, jlong handle) {
   return guarded<jdouble>(env, 0.0, [&] {
-    auto& h = from_handle<io::LogReader>(handle, "NativeLogReader");
+    auto& h = from_handle<std::unique_ptr<io::SampleSource>>(handle, "NativeLogReader");
     const std::lock_guard<std::mutex> lock(h.mutex);
-    return h.object.progress();
+    return h.object->progress();
   });
 }
 
 void reader_close(JNIEnv* env, jclass, jlong handle) {
   guarded_void(env, [&] {
-    auto* h = &from_handle<io::LogReader>(handle, "NativeLogReader");
+    auto* h = &from_handle<std::unique_ptr<io::SampleSource>>(handle, "NativeLogReader");
     { const std::lock_guard<std::mutex> lock(h->mutex); }
     delete h;
   });

@@ -42,6 +42,9 @@ struct ReadStats {
   std::map<std::string, std::int64_t> samples_by_type;  // "Accel" -> n
   std::map<std::string, std::int64_t> skipped_by_reason; // "unknown line type 'Foo'" -> n
   std::vector<LogIssue> issues;      // the first max_reported_issues skipped lines
+  /// Files (or columns) of a multi-file recording that carry nothing the core uses, with why
+  /// ("Gravity.csv" -> "gravity alone; TotalAcceleration is read"). Not skipped lines.
+  std::map<std::string, std::string> not_used;
   std::int64_t skipped_total() const;
 };
 

@@ -1,0 +1,272 @@
+// open_sample_source: format detection from content and the LogReader adapter.
+#include "pdnav/io/sample_source.h"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+
+#include "io/container.h"
+#include "io/readers.h"
+#include "io/table_source.h"
+#include "io/text.h"
+#include "pdnav/io/log_format.h"
+
+namespace pdnav::io {
+
+namespace {
+
+struct FormatName {
+  Format f;
+  std::string_view name;
+};
+constexpr std::array<FormatName, 6> kNames{{{Format::kAuto, "auto"},
+                                            {Format::kSession, "session"},
+                                            {Format::kGnssLogger, "gnsslogger"},
+                                            {Format::kSensorLogger, "sensorlogger"},
+                                            {Format::kPhyphox, "phyphox"},
+                                            {Format::kGetSensorData, "getsensordata"}}};
+
+constexpr const char* kExpected =
+    "expected a pdnav session log or GnssLogger log (text, lines 'Type,...'), a Sensor Logger or "
+    "phyphox CSV export (folder or zip), or a GetSensorData log (text, lines 'ACCE;...')";
+
+/// The LogReader as a SampleSource; a log that yields no sample is an error.
+class LogSource : public SampleSource {
+ public:
+  LogSource(LogReader r, Format f, bool require) : r_(std::move(r)), f_(f), require_(require) {}
+  bool next(Sample& out) override {
+    if (r_.next(out)) return true;
+    if (require_ && !finished_ && r_.stats().samples == 0) {
+      finished_ = true;
+      const ReadStats& st = r_.stats();
+      std::string why = std::to_string(st.lines) + " lines, " + std::to_string(st.skipped_total()) + " skipped";
+      if (!st.issues.empty()) why += " (first: " + st.issues.front().to_string() + ")";
+      throw IoError(r_.name(), 0, "no samples: " + why);
+    }
+    finished_ = true;
+    return false;
+  }
+  const ReadStats& stats() const override { return r_.stats(); }
+  double progress() const override { return r_.progress(); }
+  const std::string& name() const override { return r_.name(); }
+  const std::map<std::string, std::string>& header_info() const override { return r_.header_info(); }
+  Format format() const override { return f_; }
+
+ private:
+  LogReader r_;
+  Format f_;
+  bool require_;
+  bool finished_ = false;
+};
+
+bool starts_with(std::string_view s, std::string_view p) { return s.substr(0, p.size()) == p; }
+
+/// GetSensorData line-type tokens (IPIN competition logfile description).
+bool is_gsd_token(std::string_view t) {
+  static constexpr std::string_view kTokens[] = {"ACCE", "GYRO", "MAGN", "PRES", "AHRS", "GNSS", "POSI", "WIFI",
+                                                 "BLUE", "LIGH", "SOUN", "PROX", "HUMI", "TEMP", "RFID", "IMUX",
+                                                 "IMUL", "IMUI", "ACC1", "GYR1", "MAG1"};
+  return std::find(std::begin(kTokens), std::end(kTokens), t) != std::end(kTokens);
+}
+
+/// What a text file looks like, from its first bytes.
+Format sniff_text(const std::string& head, std::string& found) {
+  std::istringstream in(head);
+  std::string line;
+  int seen = 0, log_lines = 0, gsd_lines = 0, other = 0;
+  bool session = false, gnsslogger = false;
+  std::string first;
+  const auto types = line_type_names();
+  while (std::getline(in, line) && seen < 200) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::string_view t = detail::trim(line);
+    if (t.empty()) continue;
+    if (first.empty()) first = std::string(t);
+    ++seen;
+    if (seen == 1) {
+      if (detail::is_sensorlogger_header(std::string(t))) return Format::kSensorLogger;
+      if (detail::is_phyphox_header(std::string(t))) return Format::kPhyphox;
+    }
+    if (t.front() == '#') {
+      if (t.find("pdnav-log") != std::string_view::npos) session = true;
+      if (t.find("GnssLogger") != std::string_view::npos || t.find("Version: v") != std::string_view::npos) gnsslogger = true;
+      const std::string_view body = detail::trim(t.substr(1));
+      const std::string_view tok = body.substr(0, std::min(body.find(','), body.size()));
+      if (std::find(types.begin(), types.end(), tok) != types.end()) ++log_lines;
+      continue;
+    }
+    if (t.front() == '%') { ++gsd_lines; continue; }  // GetSensorData comment header
+    const std::string_view tok = t.substr(0, std::min(t.find_first_of(",;"), t.size()));
+    if (t.size() > tok.size() && t[tok.size()] == ';' && is_gsd_token(tok)) ++gsd_lines;
+    else if (t.size() > tok.size() && t[tok.size()] == ',' && std::find(types.begin(), types.end(), tok) != types.end()) ++log_lines;
+    else ++other;
+  }
+  if (log_lines > 0 && log_lines >= gsd_lines) return session || !gnsslogger ? Format::kSession : Format::kGnssLogger;
+  if (gsd_lines > 0) return Format::kGetSensorData;
+  found = first.empty() ? "no text lines" : "first line '" + detail::printable(first, 60) + "'";
+  return Format::kAuto;
+}
+
+std::string read_head(const std::string& path, std::size_t n) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw IoError(path, 0, std::string("cannot open: ") + std::strerror(errno));
+  std::string s(n, '\0');
+  f.read(s.data(), static_cast<std::streamsize>(n));
+  s.resize(static_cast<std::size_t>(f.gcount()));
+  return s;
+}
+
+bool is_ole2(const std::string& head) { return head.size() >= 4 && std::memcmp(head.data(), "\xD0\xCF\x11\xE0", 4) == 0; }
+
+[[noreturn]] void not_recognised(const std::string& path, const std::string& found) {
+  throw IoError(path, 0, std::string("not a recording pdnav reads: ") + kExpected + "; found " + found);
+}
+
+std::unique_ptr<SampleSource> open_container(std::unique_ptr<detail::Container> c, Format fmt, SourceOptions opt) {
+  std::string found;
+  const Format sniffed = detail::sniff_container(*c, found);
+  if (fmt == Format::kAuto) fmt = sniffed;
+  if (fmt == Format::kAuto) not_recognised(c->name(), found);
+  if (fmt == Format::kSensorLogger) return detail::open_sensorlogger(std::move(c), opt);
+  if (fmt == Format::kPhyphox) return detail::open_phyphox(std::move(c), opt);
+  throw IoError(c->name(), 0, std::string("a folder or zip cannot be read as ") + std::string(format_name(fmt)) +
+                                  " (that format is one text file)");
+}
+
+}  // namespace
+
+std::string_view format_name(Format f) {
+  for (const auto& n : kNames)
+    if (n.f == f) return n.name;
+  return "unknown";
+}
+
+Format parse_format(std::string_view name) {
+  const std::string l = detail::lower_ascii(name);
+  for (const auto& n : kNames)
+    if (n.name == l) return n.f;
+  std::string all;
+  for (const auto& n : kNames) all += (all.empty() ? "" : ", ") + std::string(n.name);
+  throw std::invalid_argument("unknown format '" + std::string(name) + "' (one of: " + all + ")");
+}
+
+std::vector<std::string> format_names() {
+  std::vector<std::string> v;
+  for (const auto& n : kNames) v.emplace_back(n.name);
+  return v;
+}
+
+namespace detail {
+
+Format sniff_container(const Container& c, std::string& found) {
+  if (c.entries().empty()) { found = "no files"; return Format::kAuto; }
+  for (const Entry& e : c.entries()) {
+    const std::string p = lower_ascii(e.path);
+    if (p == "xl/workbook.xml" || p.find("/xl/workbook.xml") != std::string::npos)
+      throw IoError(c.name(), 0, "an Excel workbook (.xlsx; phyphox's Excel export) is not read: export the "
+                                 "experiment as CSV (folder or zip) instead");
+  }
+  if (c.find_path("meta/time.csv") || c.find_path("meta/device.csv")) return Format::kPhyphox;
+  const std::string root = c.root();
+  std::string names;
+  int listed = 0;
+  for (const Entry& e : c.entries()) {
+    if (listed < 8) names += (listed++ ? ", " : "") + printable(e.path, 60);
+    const std::string b = lower_ascii(e.base);
+    if (e.size == 0 || b.size() < 4 || b.substr(b.size() - 4) != ".csv") continue;
+    std::unique_ptr<EntryStream> s;
+    try {
+      s = c.open(e);
+    } catch (const IoError&) {
+      continue;
+    }
+    std::string line;
+    std::getline(s->stream(), line, '\n');
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.size() >= 3 && line.substr(0, 3) == "\xEF\xBB\xBF") line.erase(0, 3);
+    if (is_sensorlogger_header(line)) return Format::kSensorLogger;
+    if (is_phyphox_header(line)) return Format::kPhyphox;
+  }
+  if (c.entries().size() > 8) names += ", ...";
+  found = std::to_string(c.entries().size()) + " file(s) without a Sensor Logger ('time,seconds_elapsed,...') or "
+          "phyphox ('\"Time (s)\",...') CSV header: " + names;
+  return Format::kAuto;
+}
+
+}  // namespace detail
+
+Format detect_format(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const auto st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) throw IoError(path, 0, "cannot open: no such file or folder");
+  std::string found;
+  if (fs::is_directory(st)) {
+    const Format f = detail::sniff_container(*detail::open_folder(path), found);
+    if (f == Format::kAuto) not_recognised(path, found);
+    return f;
+  }
+  const std::string head = read_head(path, 1u << 16);
+  if (head.empty()) throw IoError(path, 0, "empty file (0 bytes)");
+  if (detail::looks_like_zip(head)) {
+    const Format f = detail::sniff_container(*detail::open_zip_file(path), found);
+    if (f == Format::kAuto) not_recognised(path, found);
+    return f;
+  }
+  if (is_ole2(head))
+    throw IoError(path, 0, "an Excel 97 workbook (.xls; phyphox's Excel export) is not read: export the experiment "
+                           "as CSV (folder or zip) instead");
+  const Format f = sniff_text(head, found);
+  if (f == Format::kAuto) not_recognised(path, found);
+  return f;
+}
+
+std::unique_ptr<SampleSource> open_sample_source(const std::string& path, Format fmt, SourceOptions opt) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const auto st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) throw IoError(path, 0, "cannot open: no such file or folder");
+  if (fs::is_directory(st)) return open_container(detail::open_folder(path), fmt, opt);
+  const std::string head = read_head(path, 1u << 16);
+  if (detail::looks_like_zip(head)) return open_container(detail::open_zip_file(path), fmt, opt);
+  if (fmt == Format::kAuto) fmt = detect_format(path);
+  switch (fmt) {
+    case Format::kSession:
+    case Format::kGnssLogger:
+      return std::make_unique<LogSource>(LogReader(path, opt.log), fmt, opt.require_samples);
+    case Format::kSensorLogger:
+    case Format::kPhyphox: {
+      // one CSV of a recording: read it as a recording of that one file
+      return open_container(detail::open_single_file(path), fmt, opt);
+    }
+    case Format::kGetSensorData: {
+      auto f = std::make_unique<std::ifstream>(path, std::ios::binary);
+      if (!*f) throw IoError(path, 0, std::string("cannot open: ") + std::strerror(errno));
+      return detail::open_getsensordata(std::move(f), path, fs::file_size(path, ec), opt);
+    }
+    case Format::kAuto:
+      break;
+  }
+  not_recognised(path, "nothing");
+}
+
+std::unique_ptr<SampleSource> open_memory_source(std::vector<std::pair<std::string, std::string>> files, std::string name,
+                                                 Format fmt, SourceOptions opt) {
+  if (files.size() == 1 && files[0].first.size() >= 4 &&
+      detail::lower_ascii(files[0].first.substr(files[0].first.size() - 4)) == ".zip")
+    return open_container(detail::open_zip_bytes(std::move(files[0].second), name), fmt, opt);
+  if (fmt == Format::kSession || fmt == Format::kGnssLogger || fmt == Format::kGetSensorData) {
+    if (files.size() != 1) throw IoError(name, 0, "a text log is one file");
+    auto in = std::make_unique<std::istringstream>(std::move(files[0].second));
+    if (fmt == Format::kGetSensorData) return detail::open_getsensordata(std::move(in), name, 0, opt);
+    return std::make_unique<LogSource>(LogReader(std::move(in), name, opt.log), fmt, opt.require_samples);
+  }
+  return open_container(detail::open_memory_files(std::move(files), name), fmt, opt);
+}
+
+}  // namespace pdnav::io
