@@ -25,11 +25,12 @@
 #include "pdnav/fusion/navigator.h"
 #include "pdnav/geo/frames.h"
 #include "pdnav/gnss/ephemeris.h"
-#include "pdnav/io/log_reader.h"
+#include "pdnav/io/sample_source.h"
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/route/walk_graph.h"
 #include "pdnav/terrain/dem.h"
 #include "support/replay_support.h"
+#include "support/sources.h"
 
 namespace pdnav::cli {
 namespace {
@@ -41,6 +42,7 @@ constexpr double kJumpAfterS = 60.0;       // re-acquisition jumps are looked fo
 
 struct EvalOutageArgs {
   std::vector<std::string> logs;
+  std::string format = "auto";
   double start_frac = 0.4, length_frac = 0.4, max_s = 300.0;
   double start_s = kNaNd, length_s = kNaNd;  // absolute (from the start of the GNSS span), override the fractions
   std::string dem, graph;
@@ -197,7 +199,8 @@ WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std:
   std::vector<RefPoint> fixes, truth;
   TimeNs g0 = -1, g1 = -1;
   {
-    io::LogReader reader(path);
+    const std::unique_ptr<io::SampleSource> source = open_source(path, a.format);
+    io::SampleSource& reader = *source;
     ProgressBar progress(a.quiet ? nullptr : &std::cerr, "eval-outage: reading " + r.name);
     Sample s;
     while (reader.next(s)) {
@@ -433,7 +436,10 @@ void register_eval_outage(CLI::App& app) {
       "eval-outage",
       "Cut a GNSS outage into recordings and score the fused estimate in it against the withheld fixes (or Truth) vs "
       "dead reckoning restarted at the last fix");
-  c->add_option("logs", a->logs, "recordings (session or GnssLogger logs)")->required()->check(CLI::ExistingPath);
+  c->add_option("logs", a->logs,
+                "recordings: session or GnssLogger logs, Sensor Logger / phyphox folders or zips, GetSensorData files")
+      ->required()->check(CLI::ExistingPath);
+  add_format_option(c, a->format);
   c->add_option("--start-frac", a->start_frac, "window start, fraction of the GNSS span")->capture_default_str();
   c->add_option("--length-frac", a->length_frac, "window length, fraction of the GNSS span")->capture_default_str();
   c->add_option("--max-s", a->max_s, "longest window, s")->capture_default_str();

@@ -127,6 +127,14 @@ void FusionFilter::set_residual_uncertainty(double var_b, double var_s) {
   p_(3, 3) = std::max(var_s, 1e-8);
 }
 
+double FusionFilter::heading_bias_var_after_window(double fit_var, double window_s) const {
+  if (!(opt_.heading_bias_tau_s > 0.0) || !(heading_stationary_var_ > 0.0) || !(window_s > 0.0)) return fit_var;
+  const double u = window_s / opt_.heading_bias_tau_s;
+  const double eu = std::exp(-u);
+  const double g = u < 1e-3 ? u / 3.0 : 1.0 - 2.0 * (1.0 - eu) / u + 2.0 * (u - 1.0 + eu) / (u * u);
+  return fit_var + std::clamp(g, 0.0, 1.0) * heading_stationary_var_;
+}
+
 void FusionFilter::after(TimeNs t_ns, Eigen::Vector2d* d, double* var) const {
   d->setZero();
   *var = 0.0;

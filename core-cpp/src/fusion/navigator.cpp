@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <deque>
 #include <map>
 #include <sstream>
@@ -146,26 +145,9 @@ struct Navigator::Impl {
   TimeNs shown_t_ns = 0;
   Estimate shown;
 
-  static NavigatorConfig exp_env(NavigatorConfig c) {  // EXPERIMENT-ONLY
-    auto g = [](const char* k, double* v) { if (const char* e = std::getenv(k)) *v = std::atof(e); };
-    auto gb = [](const char* k, bool* v) { if (const char* e = std::getenv(k)) *v = std::atoi(e) != 0; };
-    gb("EXP_CI", &c.fusion.aid_covariance_intersection);
-    g("EXP_AIDSCALE", &c.fusion.aid_var_scale);
-    g("EXP_AIDMIN", &c.fusion.aid_min_sigma_m);
-    g("EXP_AIDINT", &c.fusion.aid_interval_s);
-    gb("EXP_CONSIDER", &c.fusion.filter.consider_pdr_states_on_position);
-    g("EXP_TAU", &c.fusion.filter.heading_bias_tau_s);
-    g("EXP_CALS", &c.fusion.calibration.max_scale_sigma);
-    double hb = -1; g("EXP_CALB", &hb); if (hb > 0) c.fusion.calibration.max_heading_bias_sigma_rad = hb * kDegToRad;
-    gb("EXP_CALAR", &c.fusion.calibration.residual_correlation);
-    g("EXP_CALBASE", &c.fusion.calibration.min_baseline_m);
-    double me = -1; g("EXP_CALEP", &me); if (me > 0) c.fusion.calibration.min_epochs = static_cast<int>(me);
-    return c;
-  }
-  Impl(const NavigatorConfig& c0, std::uint64_t s)
-      : cfg(exp_env(c0)), seed(s), pdr(pdr_options(cfg)), fused(cfg.mode == EngineMode::kAuto), ff(cfg.fusion.filter),
-        cal(cfg.fusion.calibration) {
-    const NavigatorConfig& c = cfg;
+  Impl(const NavigatorConfig& c, std::uint64_t s)
+      : cfg(c), seed(s), pdr(pdr_options(c)), fused(c.mode == EngineMode::kAuto), ff(c.fusion.filter),
+        cal(c.fusion.calibration) {
     if ((cfg.dem || !cfg.dem_path.empty()) && wants(cfg.mode, EngineMode::kTerrain)) {
       auto dem = cfg.dem ? cfg.dem : std::make_shared<const terrain::Dem>(terrain::Dem::load(cfg.dem_path));
       terrain::TerrainOptions topt = terrain::TerrainOptions::preset(cfg.terrain_preset);
@@ -480,7 +462,10 @@ struct Navigator::Impl {
     if (p.valid && p.t_ns != applied.t_ns) {
       if (!applied.valid) ++counts["calibration published"];
       applied = p;
-      ff.set_residual_uncertainty(p.heading_bias_sigma_rad * p.heading_bias_sigma_rad, p.scale_sigma * p.scale_sigma);
+      // the fit is the bias averaged over its window; what the filter carries is the bias now
+      const double var_b = ff.heading_bias_var_after_window(p.heading_bias_sigma_rad * p.heading_bias_sigma_rad, p.span_s);
+      applied.heading_bias_sigma_rad = std::sqrt(var_b);
+      ff.set_residual_uncertainty(var_b, p.scale_sigma * p.scale_sigma);
     }
   }
 

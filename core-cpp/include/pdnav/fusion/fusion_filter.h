@@ -85,6 +85,12 @@ class FusionFilter {
   /// The calibration changed: the residual bias/scale states restart at zero with these
   /// variances (their cross-covariances with the position are dropped).
   void set_residual_uncertainty(double heading_bias_var_rad2, double scale_var);
+  /// The variance of the heading bias *now* given a calibration that fitted its average over a
+  /// window of window_s (the fit's own variance fit_var_rad2): under the Gauss-Markov model
+  /// (heading_bias_tau_s, the PDR's stated sigma) the current value differs from the window mean
+  /// by sigma^2 g(W / tau), g(u) = 1 - 2 (1 - e^-u) / u + 2 (u - 1 + e^-u) / u^2 (the
+  /// exponential autocovariance integrated over the window). Without the model: fit_var_rad2.
+  double heading_bias_var_after_window(double fit_var_rad2, double window_s) const;
   /// Position measurement at t_ns (possibly before the last step: the steps after it are
   /// taken off the prediction) through the windowed gate. `R` is its 2x2 covariance.
   /// `floor_fraction` >= 0 replaces options().position_floor_fraction for this update (and the
