@@ -35,8 +35,10 @@ def main(argv):
     run([pdnav, "simulate", "--session", "--dem", dem, "--graph", graph, "--nav", nav, "-o", log, "--seed", "11",
          "--lead", "240", "--outage-min", "0", "--outage-max", "0", "--tail", "240"])
     out = os.path.join(scratch, "out")
-    r = run([pdnav, "eval-outage", log, "--nav", nav, "--dem", dem, "--graph", graph, "--out", out,
-             "--start-frac", "0.4", "--length-frac", "0.4", "--max-s", "150"])
+    # the simulated phone is chest-mounted (the app's mount); `--mount auto` on simulated sessions
+    # is the PDR's placement estimate (docs/fusion.md "eval-outage")
+    r = run([pdnav, "eval-outage", log, "--nav", nav, "--dem", dem, "--graph", graph, "--out", out, "--mount", "chest",
+             "--start-frac", "0.4", "--length-frac", "0.4", "--max-s", "300"])
     print(r.stdout, end="")
     failures = []
     lines = r.stdout.rstrip("\n").split("\n")
@@ -49,11 +51,11 @@ def main(argv):
         failures.append(f"walks {walks} != 1")
     if "eval-outage" not in r.stderr:
         failures.append("no progress on stderr")
-    # bounds on this seed (truth reference): fused well below dead reckoning, coverage near its nominal 0.68
+    # bounds on this seed (truth reference; measured 0.411 / 8.2 m / 0.837 / 0.174): the bars
     if not (0.0 < ratio <= 0.5):
         failures.append(f"outage_ratio {ratio} not in (0, 0.5]")
-    if not (0.5 <= cov <= 0.95):
-        failures.append(f"coverage_68 {cov} not in [0.5, 0.95]")
+    if not (0.5 <= cov <= 0.9):
+        failures.append(f"coverage_68 {cov} not in [0.5, 0.9]")
     if not (0.0 <= jump <= 3.0):
         failures.append(f"max_jump_sigma {jump} not in [0, 3]")
     if not (0.1 < rms < 30.0):
@@ -64,8 +66,8 @@ def main(argv):
         sys.exit("FAIL: no window line")
     w0, w1, n_ep, n_raw, n_fix = (int(x) for x in w.groups())
     span_s = int(span.group(1))
-    if abs(w0 - 0.4 * span_s) > 1.5 or abs((w1 - w0) - min(0.4 * span_s, 150)) > 1.5:
-        failures.append(f"window {w0}-{w1} s not at 0.4 of the span {span_s} s for min(0.4 span, 150 s)")
+    if abs(w0 - 0.4 * span_s) > 1.5 or abs((w1 - w0) - min(0.4 * span_s, 300)) > 1.5:
+        failures.append(f"window {w0}-{w1} s not at 0.4 of the span {span_s} s for min(0.4 span, 300 s)")
     if n_raw < 100 or n_fix < 100 or n_ep < 100:
         failures.append(f"window removed {n_raw} Raw / {n_fix} Fix rows, scored {n_ep} epochs (expected >= 100 each)")
     if "calibration published before the window: scale" not in r.stdout:
@@ -94,7 +96,7 @@ def main(argv):
     if not all(math.isnan(float(x["dr_e_m"])) for x in rows if float(x["t_s"]) < w0 - 1):
         failures.append("dead reckoning rows before the window")
     # explicit window
-    r2 = run([pdnav, "eval-outage", log, "--nav", nav, "--start-s", "100", "--length-s", "60", "--quiet"])
+    r2 = run([pdnav, "eval-outage", log, "--nav", nav, "--mount", "chest", "--start-s", "100", "--length-s", "60", "--quiet"])
     if not re.search(r"window 100-160 s", r2.stdout) or not BAR.fullmatch(r2.stdout.rstrip("\n").split("\n")[-1]):
         failures.append(f"--start-s 100 --length-s 60 not honoured: {r2.stdout}")
     # bad input: a window outside the span; a log without fixes or truth
