@@ -42,6 +42,7 @@ struct EvalFusionArgs {
   double lead_s = 360.0, tail_s = 180.0;
   int particles = 500;
   bool quiet = false;
+  std::string fusion_model = "issue28";
 };
 
 /// Navigator estimates at the truth epochs, in the DEM frame.
@@ -281,6 +282,8 @@ int run_eval_fusion(const EvalFusionArgs& a) {
   base.graph = graph;
   base.ephemeris = eph_c;
   base.particles = a.particles;
+  if (a.fusion_model == "issue14") base.fusion = fusion::fusion_options_before_issue28();
+  else if (a.fusion_model != "issue28") throw std::invalid_argument("--fusion-model: issue28 (default) or issue14");
 
   phonesim::SessionOptions so;
   so.outage_min_s = 60.0 * a.outage_min_min;
@@ -379,6 +382,9 @@ void register_eval_fusion(CLI::App& app) {
   c->add_option("--lead", a->lead_s, "open-sky GNSS before the outage, s")->capture_default_str();
   c->add_option("--tail", a->tail_s, "walking after the outage, s")->capture_default_str();
   c->add_option("--particles", a->particles, "terrain particle count")->capture_default_str();
+  c->add_option("--fusion-model", a->fusion_model,
+                "fused covariance model: issue28 (default) | issue14 (before issue 28, for before/after figures)")
+      ->capture_default_str();
   c->add_flag("--quiet", a->quiet, "no progress on stderr");
   c->callback([a]() { run_eval_fusion(*a); });
 }

@@ -52,6 +52,7 @@ struct EvalOutageArgs {
   double height_m = kNaNd;
   std::uint64_t seed = 1;
   bool quiet = false;
+  std::string fusion_model = "issue28";
 };
 
 /// A reference position: a withheld phone fix (with its stated 1-sigma per axis) or Truth (0).
@@ -128,6 +129,8 @@ fusion::NavigatorConfig make_config(const EvalOutageArgs& a, fusion::EngineMode 
   c.ephemeris = eph;
   c.user_height_m = a.height_m;
   c.mount = pdr::mount_from_string(a.mount);
+  if (a.fusion_model == "issue14") c.fusion = fusion::fusion_options_before_issue28();
+  else if (a.fusion_model != "issue28") throw std::invalid_argument("--fusion-model: issue28 (default) or issue14");
   return c;
 }
 
@@ -452,6 +455,9 @@ void register_eval_outage(CLI::App& app) {
   c->add_option("--mount", a->mount, "phone placement (as pdnav replay)")->capture_default_str();
   c->add_option("--height", a->height_m, "user height, m (default: the log's, else unknown)");
   c->add_option("--seed", a->seed, "random seed")->capture_default_str();
+  c->add_option("--fusion-model", a->fusion_model,
+                "fused covariance model: issue28 (default) | issue14 (before issue 28, for before/after figures)")
+      ->capture_default_str();
   c->add_flag("--quiet", a->quiet, "no progress on stderr");
   c->callback([a]() { run_eval_outage(*a); });
 }

@@ -52,6 +52,20 @@ const char* to_string(FusionMode m) {
   return "?";
 }
 
+FusionOptions fusion_options_before_issue28() {
+  FusionOptions o;
+  o.aid_covariance_intersection = false;
+  o.aid_var_scale = 4.0;
+  o.filter.consider_pdr_states_on_position = false;
+  o.filter.heading_bias_tau_s = 0.0;
+  o.calibration.max_scale_sigma = 0.03;
+  o.calibration.max_heading_bias_sigma_rad = 4.0 * kDegToRad;
+  o.calibration.residual_correlation = false;
+  o.calibration.check_bias_drift = false;
+  o.calibration.independent_heading = false;
+  return o;
+}
+
 namespace {
 constexpr std::size_t kModeChangesKept = 1000;
 constexpr double kFusedRefreshS = 0.5;  // shown estimate refreshed at least this often (s of samples)

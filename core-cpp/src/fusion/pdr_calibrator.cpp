@@ -157,7 +157,8 @@ void PdrCalibrator::fit() {
   // uncertainty, prior_heading_bias_sigma_rad) while a good scale still is.
   c.heading_applied = c.heading_bias_sigma_rad <= opt_.max_heading_bias_sigma_rad;
   c.valid = c.epochs >= opt_.min_epochs && c.baseline_m >= opt_.min_baseline_m && c.scale >= opt_.min_scale &&
-            c.scale <= opt_.max_scale && c.scale_sigma <= opt_.max_scale_sigma;
+            c.scale <= opt_.max_scale && c.scale_sigma <= opt_.max_scale_sigma &&
+            (opt_.independent_heading || c.heading_applied);
   if (c.valid && !c.heading_applied) {
     c.heading_bias_rad = 0.0;
     c.heading_bias_sigma_rad = std::max(c.heading_bias_sigma_rad, opt_.prior_heading_bias_sigma_rad);

@@ -84,6 +84,12 @@ struct FusionOptions {
   double max_shown_jump_sigma = 2.5;  // hard bound of one shown move, sigma of the shown covariance
 };
 
+/// The fused estimate's model before issue 28 (plain Kalman aiding with the covariance x4, the
+/// PDR's heading sigma as white per-step noise, bias/scale learnt from every position fix, the
+/// calibrator's N_eff from the span only, 3 % / 4 deg publication): for before/after figures
+/// (`pdnav eval-fusion --fusion-model issue14`, `eval-outage` the same).
+FusionOptions fusion_options_before_issue28();
+
 /// What drives the fused estimate.
 enum class FusionMode { kNotStarted, kGnss, kGnssDegraded, kRoute, kTerrain, kPdr };
 const char* to_string(FusionMode m);

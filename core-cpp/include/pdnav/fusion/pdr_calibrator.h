@@ -25,6 +25,7 @@ struct PdrCalibrationOptions {
   double correlation_time_s = 10.0;   // GNSS error correlation (multipath): N_eff <= span / this
   bool residual_correlation = true;   // N_eff also <= the AR(1) value of the residuals (pdr_calibrator.cpp)
   bool check_bias_drift = true;       // fit the two halves of the window: how far the bias moved
+  bool independent_heading = true;    // false: one publication test on both sigmas (before issue 28)
   /// Published when it knows the scale and the heading bias at least twice as well as the
   /// fused filter's prior (10 %, 10 deg: FusionFilterOptions); the filter then carries the fit's
   /// own sigmas, so a less certain calibration is used with its honest uncertainty.
