@@ -11,6 +11,11 @@
   tools/plot.py fusion OUT_DIR [--title T] [--out DIR]
       fusion.png  a fused replay: the track coloured by the engine shown, and the horizontal
                   error and predicted 1-sigma vs time with every span without GNSS shaded
+  tools/plot.py outage DIR [--title T] [--out DIR]
+      <walk>_outage.png for every <walk>.csv of `pdnav eval-outage --out DIR`: the reference
+                  (withheld fixes or truth), the fused track and dead reckoning from the last fix,
+                  the withheld window highlighted; below, the error of both and the fused
+                  1-sigma (semi-major) and 68 % radius vs time, the window shaded
   tools/plot.py gnss CSV [--out DIR]
       gnss_track.png, gnss_error.png, gnss_sats.png from `pdnav gnss --out CSV`
 
@@ -293,6 +298,86 @@ def plot_fusion(args):
     print(f"plot: wrote {p}")
 
 
+def plot_outage(args):
+    """Each walk of an eval-outage output folder: map and error/sigma vs time, window shaded."""
+    import glob
+    import json
+    paths = sorted(p for p in glob.glob(os.path.join(args.dir, "*.csv")))
+    if not paths:
+        sys.exit(f"plot: {args.dir}: no per-walk CSV (run pdnav eval-outage --out {args.dir})")
+    out = args.out or args.dir
+    os.makedirs(out, exist_ok=True)
+    for path in paths:
+        rows = read_csv(path)
+        stem = os.path.splitext(os.path.basename(path))[0]
+        meta = {}
+        if os.path.exists(os.path.join(args.dir, stem + ".json")):
+            with open(os.path.join(args.dir, stem + ".json")) as f:
+                meta = json.load(f)
+        t = col(rows, "t_s")
+        win = col(rows, "in_window") > 0.5
+        re_, rn = col(rows, "ref_e_m"), col(rows, "ref_n_m")
+        fe, fn = col(rows, "fused_e_m"), col(rows, "fused_n_m")
+        de, dn = col(rows, "dr_e_m"), col(rows, "dr_n_m")
+        cee, cen, cnn = col(rows, "fused_cov_ee_m2"), col(rows, "fused_cov_en_m2"), col(rows, "fused_cov_nn_m2")
+        # semi-major 1-sigma of the fused covariance
+        tr, det = cee + cnn, cee * cnn - cen * cen
+        smaj = np.sqrt(np.maximum(0.0, 0.5 * tr + np.sqrt(np.maximum(0.0, 0.25 * tr * tr - det))))
+        ref_sig = col(rows, "ref_sigma_m")
+        fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(9, 11), gridspec_kw={"height_ratios": [3, 2]})
+        ax1.plot(re_[~win], rn[~win], ".", ms=3, color="0.55", label="reference (fixes used)")
+        ax1.plot(re_[win], rn[win], ".", ms=4, color="k", label="reference withheld (the outage window)")
+        ax1.plot(fe, fn, "-", lw=1.0, color="tab:blue", label="fused (auto)")
+        ax1.plot(fe[win], fn[win], "-", lw=2.2, color="tab:blue", alpha=0.6)
+        m = np.isfinite(de) & win
+        ax1.plot(de[m], dn[m], "-", lw=1.2, color="tab:red", label="dead reckoning from the last fix (uncalibrated)")
+        ia = np.where(win)[0]
+        if len(ia):
+            ax1.plot(re_[ia[0]], rn[ia[0]], "g^", ms=9, label="window start")
+            ax1.plot(re_[ia[-1]], rn[ia[-1]], "ms", ms=8, label="window end")
+            for i in ia[:: max(1, len(ia) // 12)]:  # 1-sigma ellipses along the window
+                a, b = cee[i], cnn[i]
+                c = cen[i]
+                if not (np.isfinite(a) and np.isfinite(b) and np.isfinite(c)):
+                    continue
+                w, v = np.linalg.eigh(np.array([[a, c], [c, b]]))
+                ang = np.linspace(0, 2 * np.pi, 48)
+                pts = v @ (np.sqrt(np.maximum(w, 0))[:, None] * np.vstack([np.cos(ang), np.sin(ang)]))
+                ax1.plot(fe[i] + pts[0], fn[i] + pts[1], "-", lw=0.6, color="tab:blue", alpha=0.7)
+        ax1.set_aspect("equal")
+        ax1.set_xlabel("east (m)")
+        ax1.set_ylabel("north (m)")
+        ax1.legend(loc="best", fontsize=8)
+        cal = meta.get("calibration_before_window", {})
+        sub = ""
+        if cal.get("valid"):
+            sub = (f"\ncalibration before the window: scale {cal['scale']:.3f} +- {cal['scale_sigma']:.3f}, "
+                   f"heading bias {cal['heading_bias_deg']:.1f} +- {cal['heading_bias_sigma_deg']:.1f} deg "
+                   f"({cal['epochs']} epochs, {cal['baseline_m']:.0f} m)")
+        elif meta:
+            sub = "\nno calibration published before the window"
+        ax1.set_title((args.title or f"{stem}: GNSS outage cut into the recording") + sub, fontsize=10)
+        if len(ia):
+            ax2.axvspan(t[ia[0]], t[ia[-1]], color="0.88", lw=0, label="GNSS withheld")
+        ax2.plot(t, col(rows, "fused_err_m"), "b-", lw=0.9, label="fused error")
+        ax2.plot(t, col(rows, "dr_err_m"), "r-", lw=0.9, label="dead reckoning error")
+        ax2.plot(t, smaj, "b--", lw=0.8, label="fused 1-sigma (semi-major)")
+        ax2.plot(t, np.sqrt(2.2958 * (smaj ** 2 + ref_sig ** 2)), "c:", lw=0.8,
+                 label="68 % radius of fused + reference accuracy")
+        if meta:
+            ax2.set_title(f"in the window: fused RMS {meta['fused']['rms_m']:.1f} m, DR RMS {meta['dr']['rms_m']:.1f} m, "
+                          f"ratio {meta['outage_ratio']:.2f}, coverage_68 {meta['coverage_68']:.2f}, "
+                          f"max jump {meta['max_jump_sigma']:.2f} sigma", fontsize=9)
+        ax2.set_xlabel("time since the first GNSS (s)")
+        ax2.set_ylabel("m")
+        ax2.legend(loc="upper left", fontsize=8)
+        fig.tight_layout()
+        p = os.path.join(out, stem + "_outage.png")
+        fig.savefig(p, dpi=110)
+        plt.close(fig)
+        print(f"plot: wrote {p}")
+
+
 def plot_gnss(args):
     rows = read_csv(args.csv)
     out = args.out or os.path.dirname(os.path.abspath(args.csv))
@@ -364,11 +449,15 @@ def main():
     fu.add_argument("dir")
     fu.add_argument("--out")
     fu.add_argument("--title")
+    o = sub.add_parser("outage", help="per-walk plots of a `pdnav eval-outage --out DIR` folder")
+    o.add_argument("dir")
+    o.add_argument("--out")
+    o.add_argument("--title")
     g = sub.add_parser("gnss", help="plots of a `pdnav gnss --out CSV` file")
     g.add_argument("csv")
     g.add_argument("--out")
     args = ap.parse_args()
-    {"replay": plot_replay, "fusion": plot_fusion, "gnss": plot_gnss}[args.cmd](args)
+    {"replay": plot_replay, "fusion": plot_fusion, "outage": plot_outage, "gnss": plot_gnss}[args.cmd](args)
 
 
 if __name__ == "__main__":

@@ -42,6 +42,7 @@ struct EvalFusionArgs {
   double lead_s = 360.0, tail_s = 180.0;
   int particles = 500;
   bool quiet = false;
+  std::string fusion_model = "issue28";
 };
 
 /// Navigator estimates at the truth epochs, in the DEM frame.
@@ -160,6 +161,7 @@ struct WalkResult {
   double length_m = 0, outage_s = 0;
   Drms out[5], after[5], open[5];  // fused, dr, gnss, terrain, route
   double outage_ratio = kNaNd, open_sky_ratio = kNaNd, max_jump_sigma = 0.0, reacquire_s = kNaNd;
+  int out_covered_68 = 0, out_scored = 0;  // outage epochs with truth inside the fused 68 % region / scored
   bool reacquire_censored = false;
   std::pair<double, double> cal_dr{kNaNd, kNaNd}, cal_fused{kNaNd, kNaNd};
   phonesim::SessionStats stats;
@@ -211,6 +213,14 @@ WalkResult evaluate(const phonesim::PhoneSession& ses, const fusion::NavigatorCo
     r.open[e] = drms(*tracks[e], truth, open_idx);
   }
   r.outage_ratio = r.out[0].drms_m / r.out[1].drms_m;
+  // Consistency of the fused covariance in the outage: truth inside its 68.27 % ellipse
+  // (Mahalanobis^2 <= 2.2958; docs/results.md "Coverage definitions").
+  for (const std::size_t k : out_idx) {
+    if (k >= fused.valid.size() || !fused.valid[k]) continue;
+    ++r.out_scored;
+    const double m2 = terrain::mahalanobis2(fused.cov[k], fused.en_m[k] - truth[k].en_m);
+    if (std::isfinite(m2) && m2 <= 2.2958) ++r.out_covered_68;
+  }
   r.open_sky_ratio = r.open[0].drms_m / r.open[2].drms_m;
   // Largest jump of the shown position between consecutive epochs, beyond the true motion,
   // in sigma of the two epochs' combined covariance.
@@ -272,6 +282,8 @@ int run_eval_fusion(const EvalFusionArgs& a) {
   base.graph = graph;
   base.ephemeris = eph_c;
   base.particles = a.particles;
+  if (a.fusion_model == "issue14") base.fusion = fusion::fusion_options_before_issue28();
+  else if (a.fusion_model != "issue28") throw std::invalid_argument("--fusion-model: issue28 (default) or issue14");
 
   phonesim::SessionOptions so;
   so.outage_min_s = 60.0 * a.outage_min_min;
@@ -307,10 +319,11 @@ int run_eval_fusion(const EvalFusionArgs& a) {
       std::printf("%-5d %-9llu %-14s %7s %7s %7s %7s %7s\n", w, static_cast<unsigned long long>(ws % 1000000000ULL),
                   names[s], f1(rows[s][0].drms_m).c_str(), f1(rows[s][1].drms_m).c_str(), f1(rows[s][2].drms_m).c_str(),
                   f1(rows[s][3].drms_m).c_str(), f1(rows[s][4].drms_m).c_str());
-    std::printf("      walk %d: %.0f m, outage %.0f s, %.1f sats; outage_ratio %s, max_jump_sigma %s, reacquire_s %s%s, "
+    std::printf("      walk %d: %.0f m, outage %.0f s, %.1f sats; outage_ratio %s, coverage_68 in outage %s, max_jump_sigma %s, reacquire_s %s%s, "
                 "open_sky_ratio %s; calibration over the outage (scale err %%, heading err deg): dr %s/%s fused %s/%s; "
                 "truth: stride %.3f x APT, heading bias at outage %.1f deg\n",
                 w, r.length_m, r.outage_s, r.stats.mean_sats_tracked, f3(r.outage_ratio).c_str(),
+                f3(r.out_scored > 0 ? static_cast<double>(r.out_covered_68) / r.out_scored : kNaNd).c_str(),
                 f3(r.max_jump_sigma).c_str(), f1(r.reacquire_s).c_str(), r.reacquire_censored ? " (never, censored)" : "",
                 f3(r.open_sky_ratio).c_str(), f1(100 * r.cal_dr.first).c_str(), f1(r.cal_dr.second).c_str(),
                 f1(100 * r.cal_fused.first).c_str(), f1(r.cal_fused.second).c_str(), r.stats.walker_stride_scale,
@@ -326,7 +339,10 @@ int run_eval_fusion(const EvalFusionArgs& a) {
     throw std::runtime_error("eval-fusion: only " + std::to_string(results.size()) + " of " + std::to_string(a.walks) +
                              " walks could be simulated");
   std::vector<double> ratio, jump, reacq, open, e_out[5], e_after[5];
+  int covered = 0, scored = 0;
   for (const auto& r : results) {
+    covered += r.out_covered_68;
+    scored += r.out_scored;
     ratio.push_back(r.outage_ratio);
     jump.push_back(r.max_jump_sigma);
     reacq.push_back(r.reacquire_s);
@@ -340,7 +356,8 @@ int run_eval_fusion(const EvalFusionArgs& a) {
               f1(median(e_after[1])).c_str(), f1(median(e_after[2])).c_str(), f1(median(e_after[3])).c_str(),
               f1(median(e_after[4])).c_str());
   const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("walks: %zu run_time_s: %.1f\n", results.size(), run_s);
+  std::printf("walks: %zu run_time_s: %.1f fused coverage_68 in outages (pooled): %s\n", results.size(), run_s,
+              f3(scored > 0 ? static_cast<double>(covered) / scored : kNaNd).c_str());
   const double max_jump = *std::max_element(jump.begin(), jump.end());
   std::printf("outage_ratio: %s max_jump_sigma: %s reacquire_s: %s open_sky_ratio: %s\n", f3(median(ratio)).c_str(),
               f3(max_jump).c_str(), f3(median(reacq)).c_str(), f3(median(open)).c_str());
@@ -365,6 +382,9 @@ void register_eval_fusion(CLI::App& app) {
   c->add_option("--lead", a->lead_s, "open-sky GNSS before the outage, s")->capture_default_str();
   c->add_option("--tail", a->tail_s, "walking after the outage, s")->capture_default_str();
   c->add_option("--particles", a->particles, "terrain particle count")->capture_default_str();
+  c->add_option("--fusion-model", a->fusion_model,
+                "fused covariance model: issue28 (default) | issue14 (before issue 28, for before/after figures)")
+      ->capture_default_str();
   c->add_flag("--quiet", a->quiet, "no progress on stderr");
   c->callback([a]() { run_eval_fusion(*a); });
 }

@@ -140,6 +140,56 @@ TEST(FusionFilter, FloorFractionOverrideKeepsPositionCovarianceAtTheFilteredMeas
   EXPECT_GE(lmin_default, 0.999 * 0.25 * r(0, 0));
 }
 
+// Issue 28: an aiding engine's estimate correlated with the filter's (same PDR steps) is fused by
+// covariance intersection: the same estimate given 20 times never makes the filter more certain
+// than the estimate itself (a Kalman update would claim R / 20), and the filter moves onto it.
+TEST(FusionFilter, CovarianceIntersectionNeverAveragesARepeatedEstimate) {
+  FusionFilter f;
+  f.initialize(Eigen::Vector2d::Zero(), 20.0, 0);
+  const Eigen::Vector2d z(15.0, -10.0);
+  const Eigen::Matrix2d r = 25.0 * Eigen::Matrix2d::Identity();
+  for (int k = 1; k <= 20; ++k) {
+    const PositionUpdateResult res = f.update_position_ci(k * kNsPerS, z, r);
+    ASSERT_TRUE(res.accepted) << res.reason;
+  }
+  const Eigen::Matrix2d p = f.position_cov_m2();
+  const double lmin = 0.5 * p.trace() - std::sqrt(0.25 * p.trace() * p.trace() - p.determinant());
+  EXPECT_GT(lmin, 0.9 * 25.0);
+  EXPECT_LT((f.position_en_m() - z).norm(), 1.0);
+  // the plain Kalman update, for contrast, claims it averaged out
+  FusionFilterOptions o;
+  o.position_floor_fraction = 0.0;
+  FusionFilter g(o);
+  g.initialize(Eigen::Vector2d::Zero(), 20.0, 0);
+  for (int k = 1; k <= 20; ++k) g.update_position(k * kNsPerS, z, r, /*use_gate_policy=*/false);
+  EXPECT_LT(g.position_cov_m2()(0, 0), 0.1 * 25.0);
+}
+
+// Issue 28: the heading bias is a Gauss-Markov process with the PDR's stated sigma; the variance
+// of the bias now given a fit of its window mean follows the integrated exponential covariance.
+TEST(FusionFilter, HeadingBiasVarianceAfterAWindowFollowsTheGaussMarkovModel) {
+  FusionFilter f;  // tau 300 s
+  f.initialize(Eigen::Vector2d::Zero(), 3.0, 0);
+  PdrStep s;
+  s.t_ns = kNsPerS;
+  s.length_m = 0.7;
+  s.heading_rad = 0.0;
+  s.length_sigma_m = 0.05;
+  s.heading_sigma_rad = 15.0 * kDegToRad;
+  f.predict(s);
+  const double sh2 = std::pow(15.0 * kDegToRad, 2), fit = std::pow(2.0 * kDegToRad, 2);
+  EXPECT_NEAR(f.heading_bias_var_after_window(fit, 1e-6), fit, 1e-9);
+  // u = W / tau = 1: g = 1 - 2 (1 - 1/e) + 2 / e = 0.4715
+  EXPECT_NEAR(f.heading_bias_var_after_window(fit, 300.0), fit + 0.4715 * sh2, 1e-3 * sh2);
+  EXPECT_NEAR(f.heading_bias_var_after_window(fit, 3e5), fit + sh2, 0.01 * sh2);
+  FusionFilterOptions white;
+  white.heading_bias_tau_s = 0.0;  // the model before issue 28: the fit's variance only
+  FusionFilter g(white);
+  g.initialize(Eigen::Vector2d::Zero(), 3.0, 0);
+  g.predict(s);
+  EXPECT_NEAR(g.heading_bias_var_after_window(fit, 300.0), fit, 1e-12);
+}
+
 TEST(FusionFilter, Chi2QuantileMatchesTables) {
   EXPECT_NEAR(chi2_quantile(2, 0.99), 9.21, 0.15);
   EXPECT_NEAR(chi2_quantile(8, 0.99), 20.09, 0.2);

@@ -69,6 +69,14 @@ void FusionFilter::advance_to(TimeNs t_ns) {
     p_(1, 1) += opt_.undetected_motion_q_m2ps * dt;
   }
   const double dt_all = static_cast<double>(t_ns - t_ns_) * 1e-9;
+  if (opt_.heading_bias_tau_s > 0.0 && heading_stationary_var_ > 0.0) {
+    // first-order Gauss-Markov heading bias: decays towards 0, variance towards the stated one
+    const double phi = std::exp(-dt_all / opt_.heading_bias_tau_s);
+    x_(2) *= phi;
+    for (int i = 0; i < 6; ++i)
+      if (i != 2) p_(2, i) *= phi, p_(i, 2) *= phi;
+    p_(2, 2) = phi * phi * p_(2, 2) + heading_stationary_var_ * (1.0 - phi * phi);
+  }
   p_(2, 2) += opt_.heading_bias_rw_rad2ps * dt_all;
   p_(3, 3) += opt_.scale_rw_1ps * dt_all;
   t_ns_ = t_ns;
@@ -76,6 +84,9 @@ void FusionFilter::advance_to(TimeNs t_ns) {
 
 void FusionFilter::predict(const PdrStep& s) {
   if (!initialized_ || !std::isfinite(s.length_m) || !std::isfinite(s.heading_rad)) return;
+  const bool gm = opt_.heading_bias_tau_s > 0.0;
+  if (gm && std::isfinite(s.heading_sigma_rad) && s.heading_sigma_rad > 0.0)
+    heading_stationary_var_ = std::min(kPi, s.heading_sigma_rad) * std::min(kPi, s.heading_sigma_rad);
   advance_to(s.t_ns);
   const double psi = s.heading_rad - x_(2);
   const double len = (1.0 + x_(3)) * s.length_m;
@@ -87,8 +98,8 @@ void FusionFilter::predict(const PdrStep& s) {
   f(0, 3) = s.length_m * sp;
   f(1, 3) = s.length_m * cp;
   const double sl = std::max(opt_.min_step_length_sigma_m, std::isfinite(s.length_sigma_m) ? s.length_sigma_m : 0.0);
-  const double sh = std::max(opt_.min_step_heading_sigma_rad,
-                             std::isfinite(s.heading_sigma_rad) ? s.heading_sigma_rad : 0.0);
+  const double sh = gm ? opt_.min_step_heading_sigma_rad
+                      : std::max(opt_.min_step_heading_sigma_rad, std::isfinite(s.heading_sigma_rad) ? s.heading_sigma_rad : 0.0);
   Eigen::Matrix2d g;
   g << sp, len * cp, cp, -len * sp;
   const Eigen::Matrix2d q = g * Eigen::Vector2d(sl * sl, sh * sh).asDiagonal() * g.transpose();
@@ -116,6 +127,14 @@ void FusionFilter::set_residual_uncertainty(double var_b, double var_s) {
   p_(3, 3) = std::max(var_s, 1e-8);
 }
 
+double FusionFilter::heading_bias_var_after_window(double fit_var, double window_s) const {
+  if (!(opt_.heading_bias_tau_s > 0.0) || !(heading_stationary_var_ > 0.0) || !(window_s > 0.0)) return fit_var;
+  const double u = window_s / opt_.heading_bias_tau_s;
+  const double eu = std::exp(-u);
+  const double g = u < 1e-3 ? u / 3.0 : 1.0 - 2.0 * (1.0 - eu) / u + 2.0 * (u - 1.0 + eu) / (u * u);
+  return fit_var + std::clamp(g, 0.0, 1.0) * heading_stationary_var_;
+}
+
 void FusionFilter::after(TimeNs t_ns, Eigen::Vector2d* d, double* var) const {
   d->setZero();
   *var = 0.0;
@@ -130,7 +149,8 @@ void FusionFilter::apply_position(const Eigen::Vector2d& z, const Eigen::Matrix2
   Eigen::Matrix<double, 2, 6> h = Eigen::Matrix<double, 2, 6>::Zero();
   h(0, 0) = h(1, 1) = 1.0;
   const Eigen::Matrix2d s = h * p_ * h.transpose() + r;
-  const Eigen::Matrix<double, 6, 2> k = p_ * h.transpose() * s.inverse();
+  Eigen::Matrix<double, 6, 2> k = p_ * h.transpose() * s.inverse();
+  if (opt_.consider_pdr_states_on_position) k.middleRows<2>(2).setZero();  // Schmidt: consider states
   x_ += k * (z - h * x_);
   const Mat6 ikh = Mat6::Identity() - k * h;
   p_ = (ikh * p_ * ikh.transpose() + k * r * k.transpose()).eval();  // Joseph form
@@ -237,6 +257,65 @@ PositionUpdateResult FusionFilter::update_position(TimeNs t_ns, const Eigen::Vec
   }
   res.reason = "rejected: innovation " + fmt(res.innovation_m) + " m = " + fmt(std::sqrt(res.nis)) + " sigma (" +
                std::to_string(rejected_.size()) + " in a row)";
+  return res;
+}
+
+PositionUpdateResult FusionFilter::update_position_ci(TimeNs t_ns, const Eigen::Vector2d& z_en_m,
+                                                      const Eigen::Matrix2d& r_in) {
+  PositionUpdateResult res;
+  if (!initialized_ || !z_en_m.allFinite() || !r_in.allFinite() || !(r_in.determinant() > 0.0)) {
+    res.reason = "invalid measurement";
+    return res;
+  }
+  advance_to(t_ns);
+  Eigen::Vector2d d_after;
+  double var_after = 0.0;
+  after(t_ns, &d_after, &var_after);
+  const Eigen::Vector2d z = z_en_m + d_after;
+  const Eigen::Matrix2d r = r_in + var_after * Eigen::Matrix2d::Identity();
+  const Eigen::Vector2d nu = z - x_.head<2>();
+  const Eigen::Matrix2d pp = p_.topLeftCorner<2, 2>();
+  res.nis = nu.dot((pp + r).inverse() * nu);
+  res.innovation_m = nu.norm();
+  if (res.nis > opt_.gate_chi2) {
+    res.reason = "rejected: innovation " + fmt(res.innovation_m) + " m = " + fmt(std::sqrt(res.nis)) + " sigma";
+    return res;
+  }
+  if (!(pp.determinant() > 0.0)) {
+    res.reason = "invalid filter covariance";
+    return res;
+  }
+  // w minimising det((w Pp^-1 + (1 - w) R^-1)^-1), i.e. maximising det(w Pp^-1 + (1 - w) R^-1):
+  // log det is concave in w, golden-section search on [0, 1]
+  const Eigen::Matrix2d pi = pp.inverse(), ri = r.inverse();
+  auto f = [&](double w) { return (w * pi + (1.0 - w) * ri).determinant(); };
+  double a = 0.0, b = 1.0;
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double c = b - g * (b - a), d = a + g * (b - a), fc = f(c), fd = f(d);
+  for (int i = 0; i < 40; ++i) {
+    if (fc > fd) b = d, d = c, fd = fc, c = b - g * (b - a), fc = f(c);
+    else a = c, c = d, fc = fd, d = a + g * (b - a), fd = f(d);
+  }
+  const double w = std::clamp(0.5 * (a + b), 0.0, 1.0);
+  constexpr double kMaxW = 0.999;  // the measurement adds (almost) nothing: not used
+  if (w >= kMaxW) {
+    res.accepted = true;
+    res.reason = "accepted (covariance intersection: no information beyond the prediction)";
+    return res;
+  }
+  const double w_eff = std::max(w, 1e-3);
+  const double sw = 1.0 / std::sqrt(w_eff);
+  for (int i = 0; i < 6; ++i) {
+    if (i < 2) continue;
+    p_(0, i) *= sw, p_(1, i) *= sw, p_(i, 0) *= sw, p_(i, 1) *= sw;
+  }
+  p_.topLeftCorner<2, 2>() /= w_eff;
+  const double fl = floor_fraction_;
+  floor_fraction_ = 0.0;  // no correlated-error floor: the intersection is already conservative
+  apply_position(z, r / (1.0 - w_eff));
+  floor_fraction_ = fl;
+  res.accepted = true;
+  res.reason = "accepted (covariance intersection, w " + fmt(w, 2) + ")";
   return res;
 }
 

@@ -52,6 +52,20 @@ const char* to_string(FusionMode m) {
   return "?";
 }
 
+FusionOptions fusion_options_before_issue28() {
+  FusionOptions o;
+  o.aid_covariance_intersection = false;
+  o.aid_var_scale = 4.0;
+  o.filter.consider_pdr_states_on_position = false;
+  o.filter.heading_bias_tau_s = 0.0;
+  o.calibration.max_scale_sigma = 0.03;
+  o.calibration.max_heading_bias_sigma_rad = 4.0 * kDegToRad;
+  o.calibration.residual_correlation = false;
+  o.calibration.check_bias_drift = false;
+  o.calibration.independent_heading = false;
+  return o;
+}
+
 namespace {
 constexpr std::size_t kModeChangesKept = 1000;
 constexpr double kFusedRefreshS = 0.5;  // shown estimate refreshed at least this often (s of samples)
@@ -464,7 +478,10 @@ struct Navigator::Impl {
     if (p.valid && p.t_ns != applied.t_ns) {
       if (!applied.valid) ++counts["calibration published"];
       applied = p;
-      ff.set_residual_uncertainty(p.heading_bias_sigma_rad * p.heading_bias_sigma_rad, p.scale_sigma * p.scale_sigma);
+      // the fit is the bias averaged over its window; what the filter carries is the bias now
+      const double var_b = ff.heading_bias_var_after_window(p.heading_bias_sigma_rad * p.heading_bias_sigma_rad, p.span_s);
+      applied.heading_bias_sigma_rad = std::sqrt(var_b);
+      ff.set_residual_uncertainty(var_b, p.scale_sigma * p.scale_sigma);
     }
   }
 
@@ -619,7 +636,8 @@ struct Navigator::Impl {
       Eigen::Matrix2d r = e.cov_en_m2 * fo().aid_var_scale;
       r += fo().aid_min_sigma_m * fo().aid_min_sigma_m * Eigen::Matrix2d::Identity();
       const Eigen::Vector2d before = ff.position_en_m();
-      const PositionUpdateResult res = ff.update_position(t, z, r, /*use_gate_policy=*/false);
+      const PositionUpdateResult res = fo().aid_covariance_intersection ? ff.update_position_ci(t, z, r)
+                                                                         : ff.update_position(t, z, r, /*use_gate_policy=*/false);
       after_update(before);
       if (res.accepted) {
         *misses = 0;
@@ -785,6 +803,7 @@ NavigatorOutput Navigator::output(std::size_t max_particles) const {
   const std::size_t n = std::min(kModeChangesInOutput, impl_->changes.size());
   o.mode_changes.assign(impl_->changes.end() - static_cast<std::ptrdiff_t>(n), impl_->changes.end());
   o.calibration = impl_->applied;
+  o.calibration_fit = impl_->cal.calibration();
   o.declination_known = impl_->pdr.has_location();
   o.declination = impl_->pdr.declination();
   return o;

@@ -30,6 +30,14 @@ struct FusionFilterOptions {
   double heading_bias_rw_rad2ps = (2.0 * kDegToRad) * (2.0 * kDegToRad) / 60.0;
   /// Random walk of the residual step scale (pace changes): (1 %)^2 per minute.
   double scale_rw_1ps = 1e-4 / 60.0;
+  /// The PDR's stated heading 1-sigma (PdrStep::heading_sigma_rad: compass / rotation vector
+  /// accuracy) is the sigma of a slowly varying error (magnetic disturbances along the way, gyro
+  /// drift), not of independent per-step noise: the heading bias state is a first-order
+  /// Gauss-Markov process with that stationary sigma and this correlation time (Gelb 1974,
+  /// Sec. 3.8), taken as the calibration window (the span over which the calibrator assumes the
+  /// bias constant). Each step then keeps only min_step_heading_sigma_rad as white noise.
+  /// 0 = the stated sigma is white per-step noise (the model before issue 28).
+  double heading_bias_tau_s = 300.0;
   double min_step_heading_sigma_rad = 3.0 * kDegToRad;  // floor of a step's white heading noise
   double min_step_length_sigma_m = 0.05;                // floor of a step's white length noise
   /// Motion no step reported (shuffling, a missed detection): position random walk, m^2/s,
@@ -48,6 +56,13 @@ struct FusionFilterOptions {
   /// position variance is kept >= this fraction of the measurement's, so a run of correlated
   /// fixes never claims they averaged out (beyond the paper; docs/fusion.md). 0 = off.
   double position_floor_fraction = 0.25;
+  /// Position measurements (SPP, the GNSS KF, chipset fixes, engine aiding) leave the heading
+  /// bias and scale states as consider states (Schmidt 1966; the Schmidt-Kalman filter): their
+  /// uncertainty enters the position covariance but a position update does not shrink or move
+  /// them. Their errors are correlated over minutes (multipath, a chipset's own filter), so a run
+  /// of fixes would "learn" a PDR scale and bias it does not know; the sliding-window calibrator
+  /// (with its effective sample size) and TDCP/Doppler displacements set them (docs/fusion.md).
+  bool consider_pdr_states_on_position = true;
 };
 
 struct PositionUpdateResult {
@@ -70,12 +85,24 @@ class FusionFilter {
   /// The calibration changed: the residual bias/scale states restart at zero with these
   /// variances (their cross-covariances with the position are dropped).
   void set_residual_uncertainty(double heading_bias_var_rad2, double scale_var);
+  /// The variance of the heading bias *now* given a calibration that fitted its average over a
+  /// window of window_s (the fit's own variance fit_var_rad2): under the Gauss-Markov model
+  /// (heading_bias_tau_s, the PDR's stated sigma) the current value differs from the window mean
+  /// by sigma^2 g(W / tau), g(u) = 1 - 2 (1 - e^-u) / u + 2 (u - 1 + e^-u) / u^2 (the
+  /// exponential autocovariance integrated over the window). Without the model: fit_var_rad2.
+  double heading_bias_var_after_window(double fit_var_rad2, double window_s) const;
   /// Position measurement at t_ns (possibly before the last step: the steps after it are
   /// taken off the prediction) through the windowed gate. `R` is its 2x2 covariance.
   /// `floor_fraction` >= 0 replaces options().position_floor_fraction for this update (and the
   /// held epochs it may apply), e.g. 1 for an already-filtered, time-correlated measurement.
   PositionUpdateResult update_position(TimeNs t_ns, const Eigen::Vector2d& z_en_m, const Eigen::Matrix2d& r_m2,
                                        bool use_gate_policy = true, double floor_fraction = -1.0);
+  /// A position estimate whose error is correlated with the filter's by an unknown amount (an
+  /// aiding engine driven by the same PDR steps): covariance intersection on the position block
+  /// (Julier & Uhlmann 1997): with w in (0, 1] minimising det of the fused position covariance,
+  /// the position rows/columns of P are scaled by 1/sqrt(w) and R by 1/(1 - w) before a Kalman
+  /// update, which stays consistent for any cross-correlation. Gated at gate_chi2 on P_pos + R.
+  PositionUpdateResult update_position_ci(TimeNs t_ns, const Eigen::Vector2d& z_en_m, const Eigen::Matrix2d& r_m2);
   /// Displacement since the clone (the last GNSS epoch), e.g. TDCP. Returns accepted.
   bool update_displacement(TimeNs t_ns, TimeNs from_ns, const Eigen::Vector2d& d_en_m, const Eigen::Matrix2d& r_m2,
                            double* nis = nullptr);
@@ -110,6 +137,7 @@ class FusionFilter {
   Vec6 x_ = Vec6::Zero();
   Mat6 p_ = Mat6::Identity();
   TimeNs t_ns_ = 0;
+  double heading_stationary_var_ = -1.0;  // the PDR's stated heading variance (last step), < 0 unknown
   TimeNs last_step_ns_ = -1;
   TimeNs last_accept_ns_ = -1;
   bool clone_ok_ = false;

@@ -68,8 +68,13 @@ struct FusionOptions {
   double anchor_interval_s = 5.0;     // while GNSS is good: terrain/route re-anchored this often
   double aid_after_s = 5.0;           // no GNSS this long: terrain/route become measurements
   double aid_interval_s = 10.0;       // ... at most this often (they share the PDR steps)
-  double aid_var_scale = 4.0;         // ... with their covariance times this (correlation)
-  double aid_min_sigma_m = 5.0;       // ... floored at this 1-sigma
+  /// ... fused by covariance intersection (Julier & Uhlmann 1997): the engines are driven by
+  /// the same PDR steps as the filter and re-anchored to it, so their errors are correlated with
+  /// the filter's by an unknown amount (docs/fusion.md "Aiding in outages"). false: a plain
+  /// Kalman update with the covariance times aid_var_scale (the model before issue 28).
+  bool aid_covariance_intersection = true;
+  double aid_var_scale = 1.0;         // ... their covariance times this
+  double aid_min_sigma_m = 5.0;       // ... plus this 1-sigma (map/model error the engines do not state)
   bool aid_with_route = true;
   bool aid_with_terrain = true;
   int wrong_lock_after = 3;           // engine rejected this many times in a row: re-anchored
@@ -78,6 +83,12 @@ struct FusionOptions {
   double blend_tau_s = 2.0;           // exponential blend time constant
   double max_shown_jump_sigma = 2.5;  // hard bound of one shown move, sigma of the shown covariance
 };
+
+/// The fused estimate's model before issue 28 (plain Kalman aiding with the covariance x4, the
+/// PDR's heading sigma as white per-step noise, bias/scale learnt from every position fix, the
+/// calibrator's N_eff from the span only, 3 % / 4 deg publication): for before/after figures
+/// (`pdnav eval-fusion --fusion-model issue14`, `eval-outage` the same).
+FusionOptions fusion_options_before_issue28();
 
 /// What drives the fused estimate.
 enum class FusionMode { kNotStarted, kGnss, kGnssDegraded, kRoute, kTerrain, kPdr };
@@ -134,6 +145,7 @@ struct NavigatorOutput {
   std::vector<ModeChange> mode_changes;         // the most recent ones (up to 32), oldest first
   std::int64_t mode_change_count = 0;           // all since the start
   PdrCalibration calibration;                   // the PDR calibration in use (valid once published)
+  PdrCalibration calibration_fit;               // the latest window fit, published or not (why not: its sigmas)
   /// The magnetic declination applied to the PDR headings: its WMM model and any warning
   /// (date outside every model's span, no UTC time). declination_known is false while the
   /// headings are still magnetic (no location yet).

@@ -22,9 +22,16 @@ struct PdrCalibrationOptions {
   double window_s = 300.0;            // Walker 2019 Sec. 3: sliding window (5 min here)
   double min_baseline_m = 20.0;       // RMS spread of the PDR track in the window before publishing
   int min_epochs = 20;                // GNSS epochs in the window before publishing
-  double correlation_time_s = 10.0;   // GNSS error correlation (multipath): N_eff = span / this
-  double max_scale_sigma = 0.03;      // publish only when the scale is known to 3 %
-  double max_heading_bias_sigma_rad = 4.0 * kDegToRad;  // ... and the bias to 4 deg
+  double correlation_time_s = 10.0;   // GNSS error correlation (multipath): N_eff <= span / this
+  bool residual_correlation = true;   // N_eff also <= the AR(1) value of the residuals (pdr_calibrator.cpp)
+  bool check_bias_drift = true;       // fit the two halves of the window: how far the bias moved
+  bool independent_heading = true;    // false: one publication test on both sigmas (before issue 28)
+  /// Published when it knows the scale and the heading bias at least twice as well as the
+  /// fused filter's prior (10 %, 10 deg: FusionFilterOptions); the filter then carries the fit's
+  /// own sigmas, so a less certain calibration is used with its honest uncertainty.
+  double max_scale_sigma = 0.05;
+  double max_heading_bias_sigma_rad = 5.0 * kDegToRad;
+  double prior_heading_bias_sigma_rad = 10.0 * kDegToRad;  // = FusionFilterOptions::initial_heading_bias_sigma_rad
   double min_scale = 0.5, max_scale = 1.8;  // a fit outside is not a calibration (wrong data)
   std::size_t max_steps_kept = 4096;  // bound on the step history (memory)
 };
@@ -36,8 +43,14 @@ struct PdrCalibration {
   double heading_bias_rad = 0.0;      // PDR heading = true heading + bias
   double scale_sigma = 0.0;
   double heading_bias_sigma_rad = 0.0;
+  bool heading_applied = true;        // false: the heading fit was too uncertain, bias 0 +- the prior
   int epochs = 0;                     // GNSS epochs in the window
   double baseline_m = 0.0;            // RMS spread of the PDR track in the window
+  double residual_rho = 0.0;          // lag-1 autocorrelation of the fit residuals (N_eff)
+  double span_s = 0.0;                // time from the first to the last epoch of the window
+  /// How far the heading bias moved within the window: the two halves of the PDR path fitted
+  /// separately differ by this beyond their own sigmas (0 when they agree).
+  double heading_bias_drift_sigma_rad = 0.0;
 };
 
 class PdrCalibrator {
