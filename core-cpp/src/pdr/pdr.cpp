@@ -250,6 +250,7 @@ void Pdr::finish() {
 
 void Pdr::feed(const GyroSample& s) {
   tracker_.feed(s);
+  placement_.feed(s);  // the tilt filter levels the walking-direction correlation
   classifier_.feed(s);
   track_handling();
   if (s.rate_radps.allFinite() && s.t_ns >= last_gyro_ns_) last_gyro_ns_ = s.t_ns;
