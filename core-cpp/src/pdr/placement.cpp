@@ -34,7 +34,7 @@ void PlacementEstimator::start_bout(TimeNs t_ns) {
   corr_.setZero();
   cov_h_.setZero();
   var_v_ = n_corr_ = walking_s_ = 0.0;
-  prior_supported_ = reversed_ = prior_rejected_ = false;
+  prior_supported_ = reversed_ = prior_rejected_ = bout_levelled_ = false;
   // placement from the dominant gravity axis; the reference axis is the placement's prior
   // walking axis (flat: +Y, upright: -Z), else the most horizontal of +X, +Y, -Z
   const double ax = std::abs(up_.x()), ay = std::abs(up_.y()), az = std::abs(up_.z());
@@ -120,6 +120,7 @@ void PlacementEstimator::feed(const AccelSample& s, bool walking) {
   // flat phone keeps the 2 s mean: there the hand's pitch at the step frequency is part of the
   // forward-phase signature (levelled, the sign of 3 of the 43 ILC walks flips, 2.44 -> 2.68 m)
   const bool level = tilt_ok_ && bout_.placement != Placement::kFlat;
+  if (walking) bout_levelled_ = level;
   const Eigen::Vector3d& u = level ? tilt_up_ : up_;
   const Eigen::Vector3d lin = gait_band(level ? Eigen::Vector3d(s.acc_mps2 - mean.norm() * u) : Eigen::Vector3d(s.acc_mps2 - mean), dt);
   const double av = lin.dot(u);
@@ -142,6 +143,10 @@ double PlacementEstimator::flip_threshold() const {
   // the correlation of T seconds of gait scatters as 1/sqrt(T): a reversal of the prior needs
   // flip_corr at flip_settle_s of walking, proportionally more before
   const double t = std::max(walking_s_, 1e-3);
+  // a levelled bout (gyro-propagated tilt: pockets, at the ear) has no tilt leakage that could
+  // fake the phase: once settled the correlation's sign itself decides (its magnitude is
+  // 0.2-0.3 there, near flip_corr, against 0.25-0.5 for the unlevelled texting correlation)
+  if (bout_levelled_ && walking_s_ >= opt_.flip_settle_s) return 0.0;
   return opt_.flip_corr * std::max(1.0, std::sqrt(opt_.flip_settle_s / t));
 }
 

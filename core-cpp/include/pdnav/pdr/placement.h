@@ -156,6 +156,7 @@ class PlacementEstimator {
   double walking_s_ = 0.0;
   bool prior_supported_ = false;  // running phase correlation along the prior axis > 0
   bool prior_rejected_ = false;   // the motion's direction is off the prior's line
+  bool bout_levelled_ = false;    // the bout's correlation is split about the tilt filter's gravity
   // tilt filter (gravity direction in phone axes, gyro-propagated)
   Eigen::Vector3d tilt_up_ = Eigen::Vector3d::UnitZ();
   bool tilt_ok_ = false;
