@@ -53,8 +53,35 @@ void Pdr::sync_placement() {
   fusion_reference_ = placement_.reference_phone();
 }
 
-void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight) {
+const char* to_string(HeadingSource s) {
+  switch (s) {
+    case HeadingSource::kGyro: return "gyro";
+    case HeadingSource::kCompass: return "compass";
+    case HeadingSource::kRotationVector: return "rotation-vector";
+    case HeadingSource::kInitial: break;
+  }
+  return "initial";
+}
+
+HeadingSource Pdr::heading_source(TimeNs t_ns) const {
+  if (!fusion_.valid() || abs_weight_ns_ < 0) return HeadingSource::kInitial;
+  // the mean weight decays toward 0 while no reading arrives: the gyro alone carries it then
+  const double age_s = std::max(0.0, ns_to_s(t_ns - abs_weight_ns_));
+  const double w = abs_weight_mean_ * std::exp(-age_s / opt_.source_tau_s);
+  return w >= opt_.trusted_source_weight ? abs_kind_ : HeadingSource::kGyro;
+}
+
+void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight, HeadingSource kind) {
   if (handling_reset_) return;  // handled: no offset is learned (track_handling)
+  // decayed mean of the readings' weights (source report only)
+  if (kind != abs_kind_ || abs_weight_ns_ < 0) {
+    abs_kind_ = kind;
+    abs_weight_mean_ = weight;
+  } else {
+    const double a = std::exp(-std::max(0.0, ns_to_s(t_ns - abs_weight_ns_)) / opt_.source_tau_s);
+    abs_weight_mean_ = a * abs_weight_mean_ + (1.0 - a) * weight;
+  }
+  abs_weight_ns_ = t_ns;
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s &&
                          tracker_.has_gravity();
   fusion_.add(t_ns, heading_mag_rad, tracker_.yaw_rad(), weight, gyro_live);
@@ -119,6 +146,7 @@ Pdr::HeldStep Pdr::hold(const StepCandidate& c) const {
   h.magnetic = fusion_.valid();
   h.heading_rad = wrap_two_pi(heading_rad() - (h.magnetic ? declination_rad_ : 0.0));
   h.heading_sigma_rad = heading_sigma_rad();
+  h.source = heading_source(c.t_ns);
   if (opt_.heading.mount == Mount::kAuto) {
     h.offset_rad = placement_.forward_offset_rad();
     // a step before the bout's gravity is known belongs to the bout that starts next
@@ -279,7 +307,8 @@ void Pdr::feed(const MagSample& s) {
   if (have_rv_ && ns_to_s(s.t_ns - last_rv_ns_) <= opt_.heading.rv_max_age_s) return;  // RV wins
   if (!compass) return;
   absolute_heading(s.t_ns, *compass,
-                   qsf_weight() * mag_accuracy_weight_ * fusion_.field_weight(s.field_ut, tracker_.up_phone()));
+                   qsf_weight() * mag_accuracy_weight_ * fusion_.field_weight(s.field_ut, tracker_.up_phone()),
+                   HeadingSource::kCompass);
 }
 
 void Pdr::feed(const SensorAccuracySample& s) {
@@ -308,7 +337,7 @@ void Pdr::feed(const RotationVectorSample& s) {
   // nominal reading, never above it
   if (std::isfinite(s.heading_accuracy_rad) && s.heading_accuracy_rad > 0.0)
     w *= std::clamp(std::pow(opt_.fusion.base_sigma_rad / s.heading_accuracy_rad, 2), opt_.fusion.disturbed_weight, 1.0);
-  absolute_heading(s.t_ns, *h, w);
+  absolute_heading(s.t_ns, *h, w, HeadingSource::kRotationVector);
 }
 
 void Pdr::feed(const StepDetectorSample& s) {
@@ -371,6 +400,10 @@ void Pdr::emit_step(const HeldStep& h) {
   distance_m_ += st.length_m;
   steps_.push_back(st);
   steps_magnetic_.push_back(h.magnetic ? 1 : 0);
+  if (source_spans_.empty() || source_spans_.back().source != h.source)
+    source_spans_.push_back({st.t_ns, st.t_ns, h.source, 0});
+  source_spans_.back().t_end_ns = std::max(source_spans_.back().t_end_ns, st.t_ns);
+  ++source_spans_.back().steps;
   ++step_count_;
 }
 

@@ -27,6 +27,23 @@ enum class StepSource {
   kAuto,           // Android events while they arrive (within android_timeout_s), else accelerometer
 };
 
+/// Where a step's heading came from (issue 27, reported per segment in replay's summary.json):
+/// the heading filter (HeadingFusion) is always gyro-propagated; this names the absolute
+/// reference that set its offset around the step. kRotationVector / kCompass: readings of that
+/// stream passed the field tests (recent mean weight >= PdrOptions::trusted_source_weight);
+/// kGyro: the field was disturbed around the step, the gyro carried the heading from earlier
+/// readings; kInitial: no absolute reading yet (the configured initial heading, gyro-propagated).
+enum class HeadingSource { kInitial, kGyro, kCompass, kRotationVector };
+const char* to_string(HeadingSource s);
+
+/// Consecutive emitted steps with one heading source.
+struct HeadingSourceSpan {
+  TimeNs t_start_ns = 0;
+  TimeNs t_end_ns = 0;
+  HeadingSource source = HeadingSource::kInitial;
+  std::int64_t steps = 0;
+};
+
 struct PdrOptions {
   StepDetectorOptions detector;  // APT Sec. V-A (+ gates)
   StepLengthModel length;        // APT Sec. V-A: l = c1 * height
@@ -43,6 +60,11 @@ struct PdrOptions {
   /// fraction over the window below.
   double consistency_tolerance = 0.10;
   double consistency_window_s = 30.0;
+  // Heading source report: mean weight of the absolute readings over the last source_tau_s
+  // (HeadingFusionOptions::decorrelation_s) at or above this = that stream is the source, below =
+  // the gyro (the weight is 1 for a reading passing the field tests, disturbed_weight otherwise).
+  double source_tau_s = 5.0;
+  double trusted_source_weight = 0.5;
 };
 
 /// Sample counters by sensor and reason (skipped or reset).
@@ -135,6 +157,8 @@ class Pdr {
     return {classifier_.vehicle_spans().begin(), classifier_.vehicle_spans().end()};
   }
   MotionState motion_state() const { return classifier_.state(); }
+  /// The heading source of the emitted steps, as spans of consecutive steps.
+  const std::vector<HeadingSourceSpan>& heading_sources() const { return source_spans_; }
   /// Sum of the emitted step lengths (m).
   double distance_m() const { return distance_m_; }
 
@@ -150,6 +174,7 @@ class Pdr {
     Eigen::Vector3d reference_phone = Eigen::Vector3d::Zero();  // axis its heading refers to
     bool android = false;  // an Android step-detector event (emitted directly, no placement wait)
     bool handling_suspect = false;  // delivered while the rotation looked like handling starting
+    HeadingSource source = HeadingSource::kInitial;
   };
   HeldStep hold(const StepCandidate& c) const;
   void release(const std::vector<HeldStep>& steps, TimeNs now_ns);
@@ -173,7 +198,8 @@ class Pdr {
   bool android_active(TimeNs t_ns) const;
   void trim_consistency(TimeNs t_ns);
   Eigen::Vector3d reference_axis() const;
-  void absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight);
+  void absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight, HeadingSource kind);
+  HeadingSource heading_source(TimeNs t_ns) const;
   void sync_placement();
 
   PdrOptions opt_;
@@ -218,6 +244,11 @@ class Pdr {
   std::vector<PdrStep> steps_;
   std::deque<HeldStep> undecided_;  // released, waiting for the walking direction
   std::vector<char> steps_magnetic_;  // per steps_ entry: heading still magnetic
+  // heading source: the latest absolute stream and the decayed mean weight of its readings
+  HeadingSource abs_kind_ = HeadingSource::kInitial;
+  double abs_weight_mean_ = 0.0;
+  TimeNs abs_weight_ns_ = -1;
+  std::vector<HeadingSourceSpan> source_spans_;
   std::int64_t step_count_ = 0;
   std::deque<TimeNs> accel_step_times_, android_step_times_;
   TimeNs last_android_ns_ = 0;
