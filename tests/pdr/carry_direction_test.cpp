@@ -62,7 +62,9 @@ Recording read_tyrex(const std::string& name) {
 /// Walking direction (phone axes) of the longest placement bout after feeding the recording up
 /// to until_s (the walker lowers the phone at the very end of some recordings).
 PlacementBout longest_bout(const Recording& r, bool with_gyro, double until_s = 110.0) {
-  Pdr pdr{PdrOptions{}};
+  PdrOptions o;
+  o.heading.mount = Mount::kAuto;
+  Pdr pdr(o);
   std::size_t g = 0;
   const TimeNs until_ns = s_to_ns(until_s);
   for (const auto& a : r.accel) {
