@@ -74,3 +74,21 @@ add_test(NAME pdr_cli_eval_pdr_waving
                  "${_pdr_ilc_out}/site1_F4_5ddb656fc5b77e0006b1792e.log")
 set_tests_properties(pdr_cli_eval_pdr_waving PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_ilc
                      PASS_REGULAR_EXPRESSION "walks with > 2: 0 of 3 .*median_mean_error_m: [0-5]\\.[0-9]+ ")
+# Issue 27: two TYREX motion-capture recordings converted by tools/tyrex2log (steps counted from
+# the capture: the slow texting walk ~1.15 Hz, the run 2.72 Hz, matching the phone's own
+# accelerometer spectrum), then the all-sets table (tools/eval-pdr-all) on them and the six
+# Oxford walks: the summary lines must parse with their baselines, and the figures stay within
+# bounds (mean error < 5 m in a 5 x 5 m room; Oxford <= 1 % mean, < 3 % worst, the issue's bar).
+set(_pdr_tyrex "${PDNAV_SHARED_DATA_DIR}/pdr-tyrex-guillaume/datasets/android")
+set(_pdr_tyrex_out "${PROJECT_BINARY_DIR}/test-scratch/pdr-all")
+add_test(NAME pdr_cli_tyrex_convert
+         COMMAND /usr/bin/python3 "${PROJECT_SOURCE_DIR}/tools/tyrex2log" --out "${_pdr_tyrex_out}/logs/tyrex"
+                 "${_pdr_tyrex}/Guillaume_Nexus5_NoDist_RunningPocket"
+                 "${_pdr_tyrex}/Guillaume_Nexus5_NoDist_Texting")
+set_tests_properties(pdr_cli_tyrex_convert PROPERTIES LABELS "pdr;cli" FIXTURES_SETUP pdr_tyrex
+                     PASS_REGULAR_EXPRESSION "carry running pocket +disturbance none +truth_steps +(29[0-9]|3[0-2][0-9]) cadence 2\\.[6-8][0-9] Hz.*carry texting +disturbance none +truth_steps +(8[5-9]|9[0-9]|10[0-9]) cadence 1\\.[0-2][0-9] Hz.*converted 2 of 2 recordings")
+add_test(NAME pdr_cli_eval_pdr_all
+         COMMAND /usr/bin/python3 "${PROJECT_SOURCE_DIR}/tools/eval-pdr-all" --sets tyrex,oxford --no-convert
+                 --out "${_pdr_tyrex_out}" --pdnav $<TARGET_FILE:pdnav> --data "${PDNAV_SHARED_DATA_DIR}")
+set_tests_properties(pdr_cli_eval_pdr_all PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
+                     PASS_REGULAR_EXPRESSION "running pocket/none +1 .*texting/none +1 .*summary tyrex sensors=all: walks 2 median_mean_error_m [0-4]\\.[0-9]+ median_rms_pct [0-9.]+ .* beats_naive [0-2] beats_still [0-2] naive_median_mean_error_m [0-9.]+ still_median_mean_error_m [0-9.]+\n.*summary oxford: walks 6 mean_step_error_pct 0\\.[0-9]+ worst_step_error_pct [0-2]\\.[0-9]+ ")

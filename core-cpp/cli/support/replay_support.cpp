@@ -263,6 +263,9 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
   j["steps"] = navigator_steps;
   j["distance_m"] = pdr.distance_m();
   j["mount"] = pdr::to_string(pdr.options().heading.mount);
+  // issue 27: which sensors the PDR had and the absolute heading they can give
+  j["sensor_set"] = pdr.sensor_set().name();
+  j["heading_reference"] = pdr.sensor_set().heading_reference();
   const pdr::PdrCounters c = pdr.counters();
   j["steps_refused_handling"] = c.steps_discarded_by_motion;
   j["steps_dropped_by_bout_gate"] = c.steps_discarded_by_bout_gate;

@@ -2,6 +2,8 @@
 // gyro) and APT turn reports.
 #include "pdnav/pdr/pdr.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 
@@ -37,7 +39,41 @@ void Pdr::set_location(const geo::Geodetic& where, std::int64_t utc_ms) {
 }
 
 Eigen::Vector3d Pdr::reference_axis() const {
-  return opt_.heading.mount == Mount::kAuto ? placement_.reference_phone() : forward_axis(opt_.heading.mount);
+  if (opt_.heading.mount != Mount::kAuto) return forward_axis(opt_.heading.mount);
+  if (!have_accel_ && have_rv_up_) return rv_reference_axis();  // no accelerometer: the RV's gravity
+  return placement_.reference_phone();
+}
+
+Eigen::Vector3d Pdr::rv_reference_axis() const {
+  // the placement estimator's priors (placement.h) from the rotation vector's gravity: screen
+  // up/down = held flat, top ahead (+Y); otherwise the more horizontal of +Y and -Z (upright:
+  // chest, shirt pocket, at the ear: camera ahead)
+  const Eigen::Vector3d& u = rv_up_phone_;
+  if (std::abs(u.z()) >= std::abs(u.x()) && std::abs(u.z()) >= std::abs(u.y())) return Eigen::Vector3d::UnitY();
+  return std::abs(u.y()) > std::abs(u.z()) ? Eigen::Vector3d(0, 0, -1) : Eigen::Vector3d::UnitY();
+}
+
+std::string PdrSensorSet::name() const {
+  std::string out;
+  const auto add = [&out](std::int64_t n, const char* what) {
+    if (n > 0) out += (out.empty() ? "" : "+") + std::string(what);
+  };
+  add(accel, "accel");
+  add(uncal_accel, "uncal accel");
+  add(gyro, "gyro");
+  add(uncal_gyro, "uncal gyro");
+  add(mag, "mag");
+  add(uncal_mag, "uncal mag");
+  add(rotation_vector, "rv");
+  add(step_detector, "steps");
+  return out.empty() ? "none" : out;
+}
+
+std::string PdrSensorSet::heading_reference() const {
+  if (rotation_vector > 0) return "rotation vector";
+  if ((mag > 0 || uncal_mag > 0) && (accel > 0 || uncal_accel > 0)) return "magnetometer";
+  if (gyro > 0 || uncal_gyro > 0) return "none (gyro-relative from the initial heading)";
+  return "none";
 }
 
 void Pdr::sync_placement() {
@@ -98,7 +134,47 @@ void Pdr::track_handling() {
   handling_reset_ = handled;
 }
 
+void Pdr::feed(const UncalAccelSample& s) {
+  if (!uncal_allowed(s.t_ns, last_cal_accel_ns_, first_uncal_accel_ns_)) return;
+  ++sensors_.uncal_accel;
+  --sensors_.accel;  // counted once, as uncalibrated
+  AccelSample a{s.t_ns, s.utc_ms, s.acc_mps2 - s.bias_mps2};
+  const TimeNs keep = last_cal_accel_ns_;
+  feed(a);
+  last_cal_accel_ns_ = keep;
+}
+
+void Pdr::feed(const UncalGyroSample& s) {
+  if (!uncal_allowed(s.t_ns, last_cal_gyro_ns_, first_uncal_gyro_ns_)) return;
+  ++sensors_.uncal_gyro;
+  --sensors_.gyro;
+  GyroSample g{s.t_ns, s.utc_ms, s.rate_radps - s.drift_radps};
+  const TimeNs keep = last_cal_gyro_ns_;
+  feed(g);
+  last_cal_gyro_ns_ = keep;
+}
+
+void Pdr::feed(const UncalMagSample& s) {
+  if (!uncal_allowed(s.t_ns, last_cal_mag_ns_, first_uncal_mag_ns_)) return;
+  ++sensors_.uncal_mag;
+  --sensors_.mag;
+  MagSample m{s.t_ns, s.utc_ms, s.field_ut - s.bias_ut};
+  const TimeNs keep = last_cal_mag_ns_;
+  feed(m);
+  last_cal_mag_ns_ = keep;
+}
+
 void Pdr::feed(const AccelSample& s) {
+  ++sensors_.accel;
+  // the first accelerometer sample after rotation-vector headings about the RV's own axis: the
+  // placement's axis takes over, the offset learned about the other one must not mix in
+  if (!have_accel_ && have_rv_up_ && opt_.heading.mount == Mount::kAuto &&
+      rv_reference_axis() != placement_.reference_phone()) {
+    fusion_.reset();
+    qsf_.reset();
+  }
+  have_accel_ = true;
+  last_cal_accel_ns_ = s.t_ns;
   tracker_.feed(s);
   classifier_.feed(s);
   track_handling();
@@ -277,6 +353,8 @@ void Pdr::finish() {
 }
 
 void Pdr::feed(const GyroSample& s) {
+  ++sensors_.gyro;
+  last_cal_gyro_ns_ = s.t_ns;
   tracker_.feed(s);
   placement_.feed(s);  // the tilt filter levels the walking-direction correlation
   classifier_.feed(s);
@@ -286,6 +364,8 @@ void Pdr::feed(const GyroSample& s) {
 }
 
 void Pdr::feed(const MagSample& s) {
+  ++sensors_.mag;
+  last_cal_mag_ns_ = s.t_ns;
   const SampleCheck c = check_sample(s.t_ns, s.field_ut.allFinite(), mag_last_ns_, have_mag_last_,
                                      opt_.heading.turn.gap_reset_s, counters_.mag);
   if (c == SampleCheck::kNonFinite || c == SampleCheck::kDuplicate || c == SampleCheck::kBackwards) return;
@@ -323,6 +403,12 @@ void Pdr::feed(const RotationVectorSample& s) {
   if (c == SampleCheck::kNonFinite || c == SampleCheck::kDuplicate || c == SampleCheck::kBackwards) return;
   last_rv_check_ns_ = s.t_ns;
   latest_ns_ = std::max(latest_ns_, s.t_ns);
+  ++sensors_.rotation_vector;
+  if (!have_accel_ && s.quat_xyzw.norm() > 0.5) {  // gravity in phone axes = R^T e_z (R: phone -> ENU)
+    const Eigen::Quaterniond q(s.quat_xyzw[3], s.quat_xyzw[0], s.quat_xyzw[1], s.quat_xyzw[2]);
+    rv_up_phone_ = q.normalized().conjugate() * Eigen::Vector3d::UnitZ();
+    have_rv_up_ = true;
+  }
   const auto h = rotation_vector_heading_rad(s.quat_xyzw, reference_axis(), opt_.heading.min_horizontal);
   have_rv_ = true;
   if (!h) return;  // reference axis near vertical: keep propagating with the gyro
@@ -345,6 +431,7 @@ void Pdr::feed(const StepDetectorSample& s) {
   if (c == SampleCheck::kDuplicate || c == SampleCheck::kBackwards) return;
   have_sd_last_ = true;
   sd_last_ns_ = s.t_ns;
+  ++sensors_.step_detector;
   latest_ns_ = std::max(latest_ns_, s.t_ns);
   android_step_times_.push_back(s.t_ns);
   have_android_ = true;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <deque>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "pdnav/geo/events.h"
@@ -65,6 +66,10 @@ struct PdrOptions {
   // the gyro (the weight is 1 for a reading passing the field tests, disturbed_weight otherwise).
   double source_tau_s = 5.0;
   double trusted_source_weight = 0.5;
+  /// An uncalibrated stream stands in for its calibrated twin once it has run this long without
+  /// it (GnssLogger logs carry both: the calibrated one is used, never a mix; some loggers
+  /// write only the uncalibrated ones).
+  double uncal_fallback_s = 1.0;
 };
 
 /// Sample counters by sensor and reason (skipped or reset).
@@ -86,6 +91,19 @@ struct PdrCounters {
   }
 };
 
+/// The sensors the PDR has been fed so far (issue 27, "every sensor set"): each stream counts
+/// when it was used. An uncalibrated stream (UncalAccel/UncalGyro/UncalMag, bias removed) is
+/// used only while its calibrated twin is absent (PdrOptions::uncal_fallback_s).
+struct PdrSensorSet {
+  std::int64_t accel = 0, gyro = 0, mag = 0, rotation_vector = 0, step_detector = 0;
+  std::int64_t uncal_accel = 0, uncal_gyro = 0, uncal_mag = 0;  // used in place of the calibrated ones
+  /// e.g. "accel+gyro+mag+rv", "rv+steps", "uncal accel+uncal gyro+uncal mag", "accel".
+  std::string name() const;
+  /// The absolute heading it can have: "rotation vector", "magnetometer", "none (gyro-relative
+  /// from the initial heading)" or "none".
+  std::string heading_reference() const;
+};
+
 /// Accelerometer detector vs Android step-detector events over the last consistency window.
 struct StepConsistency {
   std::int64_t accel_steps = 0;    // accelerometer steps in the window
@@ -103,6 +121,10 @@ class Pdr {
   void feed(const MagSample& s);
   void feed(const RotationVectorSample& s);
   void feed(const StepDetectorSample& s);
+  /// Uncalibrated streams (bias / drift removed): used only without the calibrated twin.
+  void feed(const UncalAccelSample& s);
+  void feed(const UncalGyroSample& s);
+  void feed(const UncalMagSample& s);
   /// Android sensor accuracy events: the magnetometer's (TYPE_MAGNETIC_FIELD 2 and its
   /// uncalibrated form 14) scales the weight of compass and rotation-vector headings
   /// (HeadingFusionOptions::accuracy_weight); other sensors' events are ignored.
@@ -147,6 +169,7 @@ class Pdr {
   const geo::Declination& declination() const { return declination_; }
   bool has_location() const { return has_location_; }
   PdrCounters counters() const;
+  const PdrSensorSet& sensor_set() const { return sensors_; }
   StepConsistency consistency() const;
   const PdrOptions& options() const { return opt_; }
   /// Placement bouts so far (time spans, placement, walking direction in phone axes); with a
@@ -201,6 +224,22 @@ class Pdr {
   void absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight, HeadingSource kind);
   HeadingSource heading_source(TimeNs t_ns) const;
   void sync_placement();
+  /// Without an accelerometer (a log of the fused sensors only): the reference axis from the
+  /// rotation vector's own gravity, the placement's prior (flat: +Y, upright: -Z).
+  Eigen::Vector3d rv_reference_axis() const;
+  PdrSensorSet sensors_;
+  bool have_accel_ = false;
+  bool have_rv_up_ = false;
+  Eigen::Vector3d rv_up_phone_ = Eigen::Vector3d::UnitZ();
+  TimeNs last_cal_accel_ns_ = -1, last_cal_gyro_ns_ = -1, last_cal_mag_ns_ = -1;
+  TimeNs first_uncal_accel_ns_ = -1, first_uncal_gyro_ns_ = -1, first_uncal_mag_ns_ = -1;
+  /// An uncalibrated sample is used once its stream has run uncal_fallback_s without its
+  /// calibrated twin (never mixed with it: a log with both uses the calibrated one only).
+  bool uncal_allowed(TimeNs t_ns, TimeNs last_calibrated_ns, TimeNs& first_uncal_ns) {
+    if (first_uncal_ns < 0) first_uncal_ns = t_ns;
+    const TimeNs since = last_calibrated_ns < 0 ? t_ns - first_uncal_ns : t_ns - last_calibrated_ns;
+    return ns_to_s(since) > opt_.uncal_fallback_s;
+  }
 
   PdrOptions opt_;
   StepDetector detector_;
