@@ -84,6 +84,7 @@ void MotionClassifier::update(TimeNs t_ns) {
   // their rhythm (MotionClassifierOptions::running_min_coherence): gait, not handling
   const bool running = opt_.vehicle && opt_.running_min_coherence > 0.0 && gait_corr_ >= opt_.gait_exit_min &&
                        sigma >= opt_.running_min_sigma_mps2 && gait_coherence_ >= opt_.running_min_coherence;
+  if (running && turns_like_handling(1.0)) running_last_ns_ = t_ns;
   handling_raw_ = !running && turns_like_handling(1.0);
   suspect_ = !running && turns_like_handling(opt_.suspect_fraction);
   // a session's first second (or after a gyro gap): no full window of evidence either way

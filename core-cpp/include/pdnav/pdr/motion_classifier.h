@@ -120,6 +120,8 @@ class MotionClassifier {
   /// Latest vehicle-window features: max gait autocorrelation, min / max 1 s sigma |a|.
   double gait_autocorrelation() const { return gait_corr_; }
   double vehicle_score_s() const { return vehicle_score_s_; }
+  /// Running: the phone turns as fast as handling, but the gait test passes (hold_s after).
+  bool running() const { return running_last_ns_ >= 0 && last_acc_ns_ - running_last_ns_ <= s_to_ns(opt_.hold_s); }
   /// Rotation repeating with the gait (running_min_coherence): leaky mean, -1..1.
   double gait_coherence() const { return gait_coherence_; }
   /// True when t_ns lies inside a handling span (closed, or the open one).
@@ -169,7 +171,8 @@ class MotionClassifier {
   double vehicle_score_s_ = 0.0;
   TimeNs evidence_start_ns_ = -1;
   double gait_corr_ = 0.0;
-  double gait_coherence_ = 0.0;  // leaky mean of the rotation's autocorrelation at the gait lag
+  double gait_coherence_ = 0.0;
+  TimeNs running_last_ns_ = -1;  // leaky mean of the rotation's autocorrelation at the gait lag
   std::deque<MotionSpan> vehicle_spans_;
 };
 
