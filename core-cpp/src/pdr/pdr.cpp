@@ -192,6 +192,7 @@ void Pdr::feed(const AccelSample& s) {
   gate_.set_short_walk_min_steps(gyro_gate ? opt_.detector.short_walk_min_steps_gyro : opt_.detector.short_walk_min_steps);
   gate_.set_min_steps(gyro_gate && opt_.detector.bout_min_steps_gyro > 0 ? opt_.detector.bout_min_steps_gyro
                                                                          : opt_.detector.bout_min_steps);
+  detector_.set_running(opt_.gate_handling && classifier_.running());
   const auto candidates = detector_.feed(s);
   if (detector_.counters().gaps != gaps_seen_) {  // a gap resets the detector and the bout
     gaps_seen_ = detector_.counters().gaps;
