@@ -4,6 +4,12 @@
 // waypoint errors, the heading error of every segment (estimated displacement vs surveyed
 // segment, + = clockwise), the length ratio (estimated path / waypoint polyline), and the same
 // for a naive PDR (peaks of low-passed |a|, 0.70 m steps, rotation-vector yaw of +Y).
+// Beside them, "still": the walker never leaves the start. Logs with dense truth (motion
+// capture, tools/tyrex2log) use --segment-min-m (a segment ends once the truth has moved that
+// far along its path) and --align-start-s (the track rotated about the start to fit the truth
+// over the first seconds: relative heading, the issue's RMS % of distance). --sensors keeps
+// one sensor set of the log (accel, imu, rv, uncal, game, all); --json writes one object per
+// walk (Meta Carry/Gait/Disturbance/TruthSteps included) for tools/eval-pdr-all.
 // Last line: `median_mean_error_m: X median_length_ratio: Y`.
 //   --via navigator (default): fusion::Navigator in dead-reckoning mode, exactly what
 //                              `pdnav replay --engine dr` runs;
@@ -11,6 +17,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <map>
 #include <iomanip>
 #include <iostream>
 #include <limits>
@@ -25,6 +33,7 @@
 
 #include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
 
 #include "pdnav/fusion/navigator.h"
 #include "pdnav/geo/frames.h"
@@ -58,7 +67,33 @@ struct EvalPdrArgs {
   double wave_s = 0.0;        // seconds of synthesised calibration waving at the start point (0 = none)
   std::uint64_t wave_seed = 1;
   double wave_amplitude = 1.0;
+  std::string sensors = "all";  // sensor set kept from each log (sensor_set_keeps)
+  double segment_min_m = 0.0;   // 0: a segment per Truth line (surveyed waypoints)
+  double align_start_s = 0.0;   // 0: no alignment (absolute tracks)
+  std::string json_out;         // one JSON object per walk, one per line
 };
+
+/// Whether a sample belongs to the sensor set (issue 27 "every sensor set"): accel =
+/// accelerometer only (Oxford); imu = accelerometer, gyroscope, magnetometer; rv = the
+/// rotation vector only (what `pdnav simulate` writes, with its step events); uncal = the
+/// uncalibrated streams (UncalAccel/UncalGyro/UncalMag, the calibrated accelerometer where no
+/// UncalAccel is logged); game = accelerometer, gyroscope, game rotation vector; all = as
+/// recorded. Truth, Meta and step events always pass (the step events are the phone's).
+bool sensor_set_keeps(const std::string& set, const Sample& s) {
+  if (set == "all" || std::holds_alternative<TruthSample>(s) || std::holds_alternative<MetaSample>(s)) return true;
+  const bool acc = std::holds_alternative<AccelSample>(s), gyro = std::holds_alternative<GyroSample>(s),
+             mag = std::holds_alternative<MagSample>(s), rv = std::holds_alternative<RotationVectorSample>(s),
+             steps = std::holds_alternative<StepDetectorSample>(s) || std::holds_alternative<StepCounterSample>(s),
+             uncal = std::holds_alternative<UncalAccelSample>(s) || std::holds_alternative<UncalGyroSample>(s) ||
+                     std::holds_alternative<UncalMagSample>(s),
+             game = std::holds_alternative<GameRotationVectorSample>(s);
+  if (set == "accel") return acc;
+  if (set == "imu") return acc || gyro || mag;
+  if (set == "rv") return rv || steps;
+  if (set == "uncal") return uncal || acc;
+  if (set == "game") return acc || gyro || game;
+  throw std::invalid_argument("--sensors: expected all, accel, imu, rv, uncal or game");
+}
 
 /// The naive reference PDR of the issue: low-passed |a| peaks, fixed 0.70 m, RV yaw.
 class NaivePdr {
@@ -89,12 +124,13 @@ class NaivePdr {
     const auto h = pdr::rotation_vector_heading_rad(s.quat_xyzw, Eigen::Vector3d::UnitY(), 0.25);
     if (h) yaw_rad_ = *h + declination_rad, have_yaw_ = true;
   }
-  void start(const Eigen::Vector2d& en) { pos_en_ = en; }
+  void start(const Eigen::Vector2d& en) { pos_en_ = en, steps_at_start_ = steps_; }
+  std::int64_t steps_since_start() const { return steps_ - steps_at_start_; }
   const Eigen::Vector2d& pos_en() const { return pos_en_; }
   std::int64_t steps() const { return steps_; }
 
  private:
-  std::int64_t steps_ = 0;
+  std::int64_t steps_ = 0, steps_at_start_ = 0;
   static constexpr double kCutHz = 3.0, kPeakAboveG = 1.0, kMinGapS = 0.3, kStepM = 0.70;
   bool have_ = false, have_yaw_ = false;
   TimeNs last_ns_ = 0, last_step_ns_ = 0;
@@ -110,6 +146,13 @@ struct WalkResult {
   double declination_deg = kNaN;
   std::int64_t qsf_tested = 0, qsf_static = 0;  // --via pdr: magnetometer readings, quasi-static ones
   std::int64_t waving_steps = -1, naive_waving_steps = -1;  // --wave: steps out before the walk began
+  std::map<std::string, std::string> meta;  // the log's Meta lines (latest value per key)
+  std::vector<double> still_errors_m;       // "still": the estimate stays at the start
+  std::int64_t naive_steps = 0;
+  double truth_path_m = kNaN, final_m = kNaN, naive_final_m = kNaN, still_final_m = kNaN;
+  double rms_pct = kNaN, naive_rms_pct = kNaN, still_rms_pct = kNaN;  // RMS error / truth path, % (aligned)
+  double align_deg = kNaN, naive_align_deg = kNaN;  // --align-start-s: rotation applied to the track
+  std::int64_t samples_dropped_by_sensor_set = 0;
 };
 
 double median(std::vector<double> v) {
@@ -353,9 +396,17 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   const double declination = 0.0;  // naive: magnetic heading (see below)
   std::int64_t first_utc = kMissingInt;
   std::vector<Eigen::Vector2d> truth_en, est_en, naive_en;
+  std::vector<TimeNs> truth_t;
+  std::size_t seg_start = 0;  // index of the current heading segment's first Truth point
+  double seg_path_m = 0;      // truth path since it
   double naive_path_m = 0;
   Eigen::Vector2d naive_last = Eigen::Vector2d::Zero();
   for (const Sample& s : samples) {
+    if (!sensor_set_keeps(a.sensors, s)) {
+      ++r.samples_dropped_by_sensor_set;
+      continue;
+    }
+    if (const auto* m = std::get_if<MetaSample>(&s)) r.meta[m->key] = m->value;
     if (a.wave_s > 0.0 && r.waving_steps < 0 && sample_time_ns(s) >= walk_start_ns && !std::holds_alternative<MetaSample>(s)) {
       r.waving_steps = run.steps();
       r.naive_waving_steps = naive.steps();
@@ -377,6 +428,7 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
         truth_en.push_back(Eigen::Vector2d::Zero());
         est_en.push_back(Eigen::Vector2d::Zero());
         naive_en.push_back(naive.pos_en());
+        truth_t.push_back(t->t_ns);
         continue;
       }
       const Eigen::Vector2d tr = frame.to_enu(g).p_m.head<2>();
@@ -386,14 +438,21 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
       naive_last = naive.pos_en();
       r.errors_m.push_back((est - tr).norm());
       r.naive_errors_m.push_back((naive.pos_en() - tr).norm());
-      const Eigen::Vector2d dt = tr - truth_en.back();
-      r.seg_heading_err_deg.push_back(segment_heading_error_deg(dt, est - est_en.back()));
-      // the same for the naive PDR = the phone's own (magnetic) rotation-vector heading of +Y:
-      // separates what the map frame and the field give from what our fusion adds
-      r.naive_seg_heading_err_deg.push_back(segment_heading_error_deg(dt, naive.pos_en() - naive_en.back()));
+      r.still_errors_m.push_back(tr.norm());
+      seg_path_m += (tr - truth_en.back()).norm();
+      if (seg_path_m >= a.segment_min_m) {  // a segment ends here (every Truth line when 0)
+        const Eigen::Vector2d dt = tr - truth_en[seg_start];
+        r.seg_heading_err_deg.push_back(segment_heading_error_deg(dt, est - est_en[seg_start]));
+        // the same for the naive PDR = the phone's own (magnetic) rotation-vector heading of +Y:
+        // separates what the map frame and the field give from what our fusion adds
+        r.naive_seg_heading_err_deg.push_back(segment_heading_error_deg(dt, naive.pos_en() - naive_en[seg_start]));
+        seg_start = truth_en.size();
+        seg_path_m = 0;
+      }
       truth_en.push_back(tr);
       est_en.push_back(est);
       naive_en.push_back(naive.pos_en());
+      truth_t.push_back(t->t_ns);
       continue;
     }
     run.feed(s);
@@ -423,8 +482,77 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   r.length_ratio = truth_len > 0 ? run.path_m() / truth_len : kNaN;
   r.naive_ratio = truth_len > 0 ? naive_path_m / truth_len : kNaN;
   r.steps = run.steps();
+  r.naive_steps = naive.steps_since_start();
   std::tie(r.qsf_tested, r.qsf_static) = run.quasi_static_field();
+  r.truth_path_m = truth_len;
+  r.final_m = r.errors_m.back();
+  r.naive_final_m = r.naive_errors_m.back();
+  r.still_final_m = r.still_errors_m.back();
+  // RMS error as % of the truth path, the tracks rotated about the start to fit the truth over
+  // the first align_start_s (the issue's metric for motion-capture walks; 0 = as estimated)
+  const auto rms_pct = [&](const std::vector<Eigen::Vector2d>& est, double* align_deg) {
+    double rot = 0.0;
+    if (a.align_start_s > 0.0) {
+      double cross = 0, dot = 0;
+      for (std::size_t i = 1; i < est.size() && truth_t[i] - truth_t[0] <= s_to_ns(a.align_start_s); ++i) {
+        cross += est[i].x() * truth_en[i].y() - est[i].y() * truth_en[i].x();
+        dot += est[i].dot(truth_en[i]);
+      }
+      rot = (cross != 0.0 || dot != 0.0) ? std::atan2(cross, dot) : 0.0;  // counter-clockwise
+    }
+    *align_deg = -rot / kDegToRad;  // + = the track was turned clockwise
+    const Eigen::Rotation2Dd R(rot);
+    double sq = 0;
+    for (std::size_t i = 1; i < est.size(); ++i) sq += (R * est[i] - truth_en[i]).squaredNorm();
+    return truth_len > 0 ? 100.0 * std::sqrt(sq / static_cast<double>(est.size() - 1)) / truth_len : kNaN;
+  };
+  r.rms_pct = rms_pct(est_en, &r.align_deg);
+  r.naive_rms_pct = rms_pct(naive_en, &r.naive_align_deg);
+  double sq = 0;
+  for (double e : r.still_errors_m) sq += e * e;
+  r.still_rms_pct = truth_len > 0 ? 100.0 * std::sqrt(sq / static_cast<double>(r.still_errors_m.size())) / truth_len : kNaN;
   return r;
+}
+
+nlohmann::json walk_json(const WalkResult& r, const EvalPdrArgs& a) {
+  const auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  std::vector<double> abs_h, naive_abs_h;
+  for (double h : r.seg_heading_err_deg) abs_h.push_back(std::abs(h));
+  for (double h : r.naive_seg_heading_err_deg) naive_abs_h.push_back(std::abs(h));
+  nlohmann::json j;
+  j["walk"] = r.name;
+  j["meta"] = r.meta;
+  j["sensors"] = a.sensors;
+  j["samples_dropped_by_sensor_set"] = r.samples_dropped_by_sensor_set;
+  j["scored_points"] = r.errors_m.size();
+  j["truth_path_m"] = num(r.truth_path_m);
+  j["steps"] = r.steps;
+  j["naive_steps"] = r.naive_steps;
+  j["mean_m"] = num(r.mean_m);
+  j["final_m"] = num(r.final_m);
+  j["naive_mean_m"] = num(r.naive_mean_m);
+  j["naive_final_m"] = num(r.naive_final_m);
+  j["still_mean_m"] = num(mean(r.still_errors_m));
+  j["still_final_m"] = num(r.still_final_m);
+  j["length_ratio"] = num(r.length_ratio);
+  j["naive_length_ratio"] = num(r.naive_ratio);
+  j["segments"] = r.seg_heading_err_deg.size();
+  j["seg_heading_signed_median_deg"] = num(median(r.seg_heading_err_deg));
+  j["seg_heading_abs_median_deg"] = num(median(abs_h));
+  j["naive_seg_heading_signed_median_deg"] = num(median(r.naive_seg_heading_err_deg));
+  j["naive_seg_heading_abs_median_deg"] = num(median(naive_abs_h));
+  j["seg_heading_err_deg"] = r.seg_heading_err_deg;
+  j["naive_seg_heading_err_deg"] = r.naive_seg_heading_err_deg;
+  for (auto* k : {"seg_heading_err_deg", "naive_seg_heading_err_deg"})
+    for (auto& x : j[k])
+      if (!std::isfinite(x.get<double>())) x = nullptr;
+  j["align_start_s"] = a.align_start_s;
+  j["rms_pct"] = num(r.rms_pct);
+  j["naive_rms_pct"] = num(r.naive_rms_pct);
+  j["still_rms_pct"] = num(r.still_rms_pct);
+  j["align_deg"] = num(r.align_deg);
+  j["naive_align_deg"] = num(r.naive_align_deg);
+  return j;
 }
 
 std::string join(const std::vector<double>& v, int prec) {
@@ -435,9 +563,18 @@ std::string join(const std::vector<double>& v, int prec) {
 }
 
 int run_eval_pdr(const EvalPdrArgs& a) {
+  (void)sensor_set_keeps(a.sensors, MetaSample{});  // reject a bad --sensors before any work
   std::vector<WalkResult> all;
   int failed = 0;
+  std::ofstream json;
+  if (!a.json_out.empty()) {
+    json.open(a.json_out);
+    if (!json) throw std::runtime_error("--json: cannot write " + a.json_out);
+  }
+  std::size_t done = 0;
   for (const std::string& log : a.logs) {
+    ++done;
+    if (!a.json_out.empty()) std::cerr << "eval-pdr: [" << done << "/" << a.logs.size() << "] " << log << "\n";
     try {
       all.push_back(eval_walk(log, a));
     } catch (const std::exception& e) {
@@ -445,6 +582,7 @@ int run_eval_pdr(const EvalPdrArgs& a) {
       ++failed;
       continue;
     }
+    if (json) json << walk_json(all.back(), a).dump() << "\n";
     const WalkResult& r = all.back();
     std::printf("%-48s wps %2zu steps %4lld mean_err_m %6.2f max %6.2f ratio %5.3f seg_heading_median %+5.1f | naive %6.2f ratio %5.3f\n",
                 r.name.c_str(), r.errors_m.size() + 1, static_cast<long long>(r.steps), r.mean_m,
@@ -533,6 +671,17 @@ void register_eval_pdr(CLI::App& app) {
       ->check(CLI::Range(0.0, 3.0))
       ->capture_default_str();
   c->add_flag("--quiet", a->quiet, "one line per walk");
+  c->add_option("--sensors", a->sensors, "sensor set kept from each log: all | accel | imu | rv | uncal | game")
+      ->capture_default_str();
+  c->add_option("--segment-min-m", a->segment_min_m,
+                "a heading segment ends once the truth moved this far along its path (0 = every Truth line)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
+  c->add_option("--align-start-s", a->align_start_s,
+                "rotate each track about the start to fit the truth over its first S seconds (RMS % metric; 0 = off)")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
+  c->add_option("--json", a->json_out, "write one JSON object per walk (one per line) to this file");
   c->add_flag("--legacy", a->legacy,
               "the engine as before issue 16 (chest mount, latest rotation vector, APT 1.75 m, no motion gate)");
   c->callback([a]() {

@@ -112,7 +112,9 @@ int run_replay(const ReplayArgs& a) {
         [&](const auto& x) {
           using T = std::decay_t<decltype(x)>;
           if constexpr (std::is_same_v<T, AccelSample> || std::is_same_v<T, GyroSample> || std::is_same_v<T, MagSample> ||
-                        std::is_same_v<T, RotationVectorSample> || std::is_same_v<T, StepDetectorSample>) {
+                        std::is_same_v<T, RotationVectorSample> || std::is_same_v<T, StepDetectorSample> ||
+                        std::is_same_v<T, UncalAccelSample> || std::is_same_v<T, UncalGyroSample> ||
+                        std::is_same_v<T, UncalMagSample>) {
             if (t0_ns < 0) t0_ns = x.t_ns;
             twin.feed(x);
             (void)twin.take_steps();

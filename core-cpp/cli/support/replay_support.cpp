@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iomanip>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 #include <unistd.h>
@@ -262,6 +263,9 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
   j["steps"] = navigator_steps;
   j["distance_m"] = pdr.distance_m();
   j["mount"] = pdr::to_string(pdr.options().heading.mount);
+  // issue 27: which sensors the PDR had and the absolute heading they can give
+  j["sensor_set"] = pdr.sensor_set().name();
+  j["heading_reference"] = pdr.sensor_set().heading_reference();
   const pdr::PdrCounters c = pdr.counters();
   j["steps_refused_handling"] = c.steps_discarded_by_motion;
   j["steps_dropped_by_bout_gate"] = c.steps_discarded_by_bout_gate;
@@ -281,6 +285,18 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
                      {"phase_corr", b.phase_corr}});
   }
   j["placements"] = bouts;
+  // which absolute reference held the heading, per segment of consecutive steps (issue 27)
+  nlohmann::json sources = nlohmann::json::array();
+  std::map<std::string, std::int64_t> steps_by_source;
+  for (const pdr::HeadingSourceSpan& span : pdr.heading_sources()) {
+    sources.push_back({{"source", pdr::to_string(span.source)},
+                       {"start_s", ns_to_s(span.t_start_ns - t0_ns)},
+                       {"end_s", ns_to_s(span.t_end_ns - t0_ns)},
+                       {"steps", span.steps}});
+    steps_by_source[pdr::to_string(span.source)] += span.steps;
+  }
+  j["heading_sources"] = sources;
+  j["steps_by_heading_source"] = steps_by_source;
   return j;
 }
 

@@ -372,7 +372,8 @@ struct Navigator::Impl {
           using T = std::decay_t<decltype(x)>;
           if constexpr (std::is_same_v<T, AccelSample> || std::is_same_v<T, GyroSample> || std::is_same_v<T, MagSample> ||
                         std::is_same_v<T, RotationVectorSample> || std::is_same_v<T, StepDetectorSample> ||
-                        std::is_same_v<T, SensorAccuracySample>) {
+                        std::is_same_v<T, SensorAccuracySample> || std::is_same_v<T, UncalAccelSample> ||
+                        std::is_same_v<T, UncalGyroSample> || std::is_same_v<T, UncalMagSample>) {
             pdr.feed(x);
             drain_pdr();
           } else if constexpr (std::is_same_v<T, PressureSample>) {

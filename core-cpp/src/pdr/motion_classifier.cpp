@@ -74,8 +74,19 @@ void MotionClassifier::update(TimeNs t_ns) {
     return gyro_live && ((rate_rms_ > f * opt_.handling_rate_radps && spread_ > opt_.axis_spread_min) ||
                          rate_rms_ > f * opt_.extreme_rate_radps);
   };
-  handling_raw_ = turns_like_handling(1.0);
-  suspect_ = turns_like_handling(opt_.suspect_fraction);
+  double sigma = 0.0;  // of |a| over the last window
+  if (acc_.size() >= 4) {
+    const double n = static_cast<double>(acc_.size());
+    const double mu = acc_sum_ / n;
+    sigma = std::sqrt(std::max(0.0, acc_sq_ / n - mu * mu));
+  }
+  // running: turns like handling, but with periodic foot strikes and a rotation that keeps
+  // their rhythm (MotionClassifierOptions::running_min_coherence): gait, not handling
+  const bool running = opt_.vehicle && opt_.running_min_coherence > 0.0 && gait_corr_ >= opt_.gait_exit_min &&
+                       sigma >= opt_.running_min_sigma_mps2 && gait_coherence_ >= opt_.running_min_coherence;
+  if (running && turns_like_handling(1.0)) running_last_ns_ = t_ns;
+  handling_raw_ = !running && turns_like_handling(1.0);
+  suspect_ = !running && turns_like_handling(opt_.suspect_fraction);
   // a session's first second (or after a gyro gap): no full window of evidence either way
   young_ = !gyro_.empty() && ns_to_s(gyro_.back().first - gyro_.front().first) < 0.8 * opt_.window_s;
   if (handling_raw_) handling_last_ns_ = t_ns;
@@ -95,12 +106,6 @@ void MotionClassifier::update(TimeNs t_ns) {
   if (vehicle_) {
     state_ = MotionState::kVehicle;
     return;
-  }
-  double sigma = 0.0;
-  if (acc_.size() >= 4) {
-    const double n = static_cast<double>(acc_.size());
-    const double mu = acc_sum_ / n;
-    sigma = std::sqrt(std::max(0.0, acc_sq_ / n - mu * mu));
   }
   const bool still = sigma < opt_.standing_sigma_mps2 && (!gyro_live || rate_rms_ < opt_.standing_rate_radps);
   state_ = still ? MotionState::kStanding : MotionState::kWalking;
@@ -151,7 +156,7 @@ void MotionClassifier::vehicle_sample(TimeNs t_ns, double acc_norm, const Eigen:
     cur_bin_index_ = index;
   }
   if (std::isfinite(acc_norm)) ++cur_bin_.n, cur_bin_.sum += acc_norm, cur_bin_.sq += acc_norm * acc_norm;
-  if (gyro != nullptr) ++cur_bin_.gyro_n, cur_bin_.gyro_sq += gyro->squaredNorm();
+  if (gyro != nullptr) ++cur_bin_.gyro_n, cur_bin_.gyro_sq += gyro->squaredNorm(), cur_bin_.gyro_sum += *gyro;
 }
 
 void MotionClassifier::vehicle_evaluate(TimeNs t_ns) {
@@ -172,6 +177,7 @@ void MotionClassifier::vehicle_evaluate(TimeNs t_ns) {
   const auto lag_min = static_cast<std::size_t>(std::lround(opt_.gait_lag_min_s / opt_.vehicle_bin_s));
   const auto lag_max = std::min(n - 2, static_cast<std::size_t>(std::lround(opt_.gait_lag_max_s / opt_.vehicle_bin_s)));
   double corr = -1.0;
+  std::size_t best_lag = 0;
   for (std::size_t lag = std::max<std::size_t>(1, lag_min); lag <= lag_max; ++lag) {
     const std::size_t m = n - lag;
     double ma = 0, mb = 0;
@@ -183,9 +189,32 @@ void MotionClassifier::vehicle_evaluate(TimeNs t_ns) {
       const double a = x[i] - ma, b = x[i + lag] - mb;
       ab += a * b, aa += a * a, bb += b * b;
     }
-    if (aa > 0 && bb > 0) corr = std::max(corr, ab / std::sqrt(aa * bb));
+    if (aa > 0 && bb > 0 && ab / std::sqrt(aa * bb) > corr) corr = ab / std::sqrt(aa * bb), best_lag = lag;
   }
   gait_corr_ = corr;
+  // gait coherence: the angular-rate vector (bin means) repeats at the |a| lag or twice it
+  double coherence = 0.0;
+  if (best_lag > 0 && opt_.running_min_coherence > 0.0) {
+    std::vector<Eigen::Vector3d> w(n, Eigen::Vector3d::Zero());
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < n; ++i) {
+      w[i] = bins_[i].gyro_n > 0 ? Eigen::Vector3d(bins_[i].gyro_sum / bins_[i].gyro_n) : (i ? w[i - 1] : w[i]);
+      mean += w[i];
+    }
+    mean /= static_cast<double>(n);
+    double var = 0.0;
+    for (auto& v : w) v -= mean, var += v.squaredNorm();
+    var /= static_cast<double>(n);
+    const auto at_lag = [&](std::size_t lag) {
+      if (lag >= n || var <= 1e-12) return -1.0;
+      double r = 0.0;
+      for (std::size_t i = 0; i + lag < n; ++i) r += w[i].dot(w[i + lag]);
+      return r / static_cast<double>(n - lag) / var;
+    };
+    coherence = std::max(at_lag(best_lag), at_lag(2 * best_lag));
+  }
+  const double alpha = 1.0 - std::exp(-opt_.vehicle_eval_s / std::max(1e-3, opt_.running_coherence_tau_s));
+  gait_coherence_ += alpha * (coherence - gait_coherence_);
   double gyro_cnt = 0, gyro_sq = 0;
   for (const Bin& b : bins_) gyro_cnt += b.gyro_n, gyro_sq += b.gyro_sq;
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.gyro_timeout_s && gyro_cnt >= 4;

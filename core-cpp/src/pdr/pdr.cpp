@@ -2,6 +2,8 @@
 // gyro) and APT turn reports.
 #include "pdnav/pdr/pdr.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 
@@ -37,7 +39,41 @@ void Pdr::set_location(const geo::Geodetic& where, std::int64_t utc_ms) {
 }
 
 Eigen::Vector3d Pdr::reference_axis() const {
-  return opt_.heading.mount == Mount::kAuto ? placement_.reference_phone() : forward_axis(opt_.heading.mount);
+  if (opt_.heading.mount != Mount::kAuto) return forward_axis(opt_.heading.mount);
+  if (!have_accel_ && have_rv_up_) return rv_reference_axis();  // no accelerometer: the RV's gravity
+  return placement_.reference_phone();
+}
+
+Eigen::Vector3d Pdr::rv_reference_axis() const {
+  // the placement estimator's priors (placement.h) from the rotation vector's gravity: screen
+  // up/down = held flat, top ahead (+Y); otherwise the more horizontal of +Y and -Z (upright:
+  // chest, shirt pocket, at the ear: camera ahead)
+  const Eigen::Vector3d& u = rv_up_phone_;
+  if (std::abs(u.z()) >= std::abs(u.x()) && std::abs(u.z()) >= std::abs(u.y())) return Eigen::Vector3d::UnitY();
+  return std::abs(u.y()) > std::abs(u.z()) ? Eigen::Vector3d(0, 0, -1) : Eigen::Vector3d::UnitY();
+}
+
+std::string PdrSensorSet::name() const {
+  std::string out;
+  const auto add = [&out](std::int64_t n, const char* what) {
+    if (n > 0) out += (out.empty() ? "" : "+") + std::string(what);
+  };
+  add(accel, "accel");
+  add(uncal_accel, "uncal accel");
+  add(gyro, "gyro");
+  add(uncal_gyro, "uncal gyro");
+  add(mag, "mag");
+  add(uncal_mag, "uncal mag");
+  add(rotation_vector, "rv");
+  add(step_detector, "steps");
+  return out.empty() ? "none" : out;
+}
+
+std::string PdrSensorSet::heading_reference() const {
+  if (rotation_vector > 0) return "rotation vector";
+  if ((mag > 0 || uncal_mag > 0) && (accel > 0 || uncal_accel > 0)) return "magnetometer";
+  if (gyro > 0 || uncal_gyro > 0) return "none (gyro-relative from the initial heading)";
+  return "none";
 }
 
 void Pdr::sync_placement() {
@@ -53,8 +89,35 @@ void Pdr::sync_placement() {
   fusion_reference_ = placement_.reference_phone();
 }
 
-void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight) {
+const char* to_string(HeadingSource s) {
+  switch (s) {
+    case HeadingSource::kGyro: return "gyro";
+    case HeadingSource::kCompass: return "compass";
+    case HeadingSource::kRotationVector: return "rotation-vector";
+    case HeadingSource::kInitial: break;
+  }
+  return "initial";
+}
+
+HeadingSource Pdr::heading_source(TimeNs t_ns) const {
+  if (!fusion_.valid() || abs_weight_ns_ < 0) return HeadingSource::kInitial;
+  // the mean weight decays toward 0 while no reading arrives: the gyro alone carries it then
+  const double age_s = std::max(0.0, ns_to_s(t_ns - abs_weight_ns_));
+  const double w = abs_weight_mean_ * std::exp(-age_s / opt_.source_tau_s);
+  return w >= opt_.trusted_source_weight ? abs_kind_ : HeadingSource::kGyro;
+}
+
+void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight, HeadingSource kind) {
   if (handling_reset_) return;  // handled: no offset is learned (track_handling)
+  // decayed mean of the readings' weights (source report only)
+  if (kind != abs_kind_ || abs_weight_ns_ < 0) {
+    abs_kind_ = kind;
+    abs_weight_mean_ = weight;
+  } else {
+    const double a = std::exp(-std::max(0.0, ns_to_s(t_ns - abs_weight_ns_)) / opt_.source_tau_s);
+    abs_weight_mean_ = a * abs_weight_mean_ + (1.0 - a) * weight;
+  }
+  abs_weight_ns_ = t_ns;
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s &&
                          tracker_.has_gravity();
   fusion_.add(t_ns, heading_mag_rad, tracker_.yaw_rad(), weight, gyro_live);
@@ -71,7 +134,47 @@ void Pdr::track_handling() {
   handling_reset_ = handled;
 }
 
+void Pdr::feed(const UncalAccelSample& s) {
+  if (!uncal_allowed(s.t_ns, last_cal_accel_ns_, first_uncal_accel_ns_)) return;
+  ++sensors_.uncal_accel;
+  --sensors_.accel;  // counted once, as uncalibrated
+  AccelSample a{s.t_ns, s.utc_ms, s.acc_mps2 - s.bias_mps2};
+  const TimeNs keep = last_cal_accel_ns_;
+  feed(a);
+  last_cal_accel_ns_ = keep;
+}
+
+void Pdr::feed(const UncalGyroSample& s) {
+  if (!uncal_allowed(s.t_ns, last_cal_gyro_ns_, first_uncal_gyro_ns_)) return;
+  ++sensors_.uncal_gyro;
+  --sensors_.gyro;
+  GyroSample g{s.t_ns, s.utc_ms, s.rate_radps - s.drift_radps};
+  const TimeNs keep = last_cal_gyro_ns_;
+  feed(g);
+  last_cal_gyro_ns_ = keep;
+}
+
+void Pdr::feed(const UncalMagSample& s) {
+  if (!uncal_allowed(s.t_ns, last_cal_mag_ns_, first_uncal_mag_ns_)) return;
+  ++sensors_.uncal_mag;
+  --sensors_.mag;
+  MagSample m{s.t_ns, s.utc_ms, s.field_ut - s.bias_ut};
+  const TimeNs keep = last_cal_mag_ns_;
+  feed(m);
+  last_cal_mag_ns_ = keep;
+}
+
 void Pdr::feed(const AccelSample& s) {
+  ++sensors_.accel;
+  // the first accelerometer sample after rotation-vector headings about the RV's own axis: the
+  // placement's axis takes over, the offset learned about the other one must not mix in
+  if (!have_accel_ && have_rv_up_ && opt_.heading.mount == Mount::kAuto &&
+      rv_reference_axis() != placement_.reference_phone()) {
+    fusion_.reset();
+    qsf_.reset();
+  }
+  have_accel_ = true;
+  last_cal_accel_ns_ = s.t_ns;
   tracker_.feed(s);
   classifier_.feed(s);
   track_handling();
@@ -89,6 +192,7 @@ void Pdr::feed(const AccelSample& s) {
   gate_.set_short_walk_min_steps(gyro_gate ? opt_.detector.short_walk_min_steps_gyro : opt_.detector.short_walk_min_steps);
   gate_.set_min_steps(gyro_gate && opt_.detector.bout_min_steps_gyro > 0 ? opt_.detector.bout_min_steps_gyro
                                                                          : opt_.detector.bout_min_steps);
+  detector_.set_running(opt_.gate_handling && classifier_.running());
   const auto candidates = detector_.feed(s);
   if (detector_.counters().gaps != gaps_seen_) {  // a gap resets the detector and the bout
     gaps_seen_ = detector_.counters().gaps;
@@ -119,6 +223,7 @@ Pdr::HeldStep Pdr::hold(const StepCandidate& c) const {
   h.magnetic = fusion_.valid();
   h.heading_rad = wrap_two_pi(heading_rad() - (h.magnetic ? declination_rad_ : 0.0));
   h.heading_sigma_rad = heading_sigma_rad();
+  h.source = heading_source(c.t_ns);
   if (opt_.heading.mount == Mount::kAuto) {
     h.offset_rad = placement_.forward_offset_rad();
     // a step before the bout's gravity is known belongs to the bout that starts next
@@ -249,7 +354,10 @@ void Pdr::finish() {
 }
 
 void Pdr::feed(const GyroSample& s) {
+  ++sensors_.gyro;
+  last_cal_gyro_ns_ = s.t_ns;
   tracker_.feed(s);
+  placement_.feed(s);  // the tilt filter levels the walking-direction correlation
   classifier_.feed(s);
   track_handling();
   if (s.rate_radps.allFinite() && s.t_ns >= last_gyro_ns_) last_gyro_ns_ = s.t_ns;
@@ -257,6 +365,8 @@ void Pdr::feed(const GyroSample& s) {
 }
 
 void Pdr::feed(const MagSample& s) {
+  ++sensors_.mag;
+  last_cal_mag_ns_ = s.t_ns;
   const SampleCheck c = check_sample(s.t_ns, s.field_ut.allFinite(), mag_last_ns_, have_mag_last_,
                                      opt_.heading.turn.gap_reset_s, counters_.mag);
   if (c == SampleCheck::kNonFinite || c == SampleCheck::kDuplicate || c == SampleCheck::kBackwards) return;
@@ -278,7 +388,8 @@ void Pdr::feed(const MagSample& s) {
   if (have_rv_ && ns_to_s(s.t_ns - last_rv_ns_) <= opt_.heading.rv_max_age_s) return;  // RV wins
   if (!compass) return;
   absolute_heading(s.t_ns, *compass,
-                   qsf_weight() * mag_accuracy_weight_ * fusion_.field_weight(s.field_ut, tracker_.up_phone()));
+                   qsf_weight() * mag_accuracy_weight_ * fusion_.field_weight(s.field_ut, tracker_.up_phone()),
+                   HeadingSource::kCompass);
 }
 
 void Pdr::feed(const SensorAccuracySample& s) {
@@ -293,6 +404,12 @@ void Pdr::feed(const RotationVectorSample& s) {
   if (c == SampleCheck::kNonFinite || c == SampleCheck::kDuplicate || c == SampleCheck::kBackwards) return;
   last_rv_check_ns_ = s.t_ns;
   latest_ns_ = std::max(latest_ns_, s.t_ns);
+  ++sensors_.rotation_vector;
+  if (!have_accel_ && s.quat_xyzw.norm() > 0.5) {  // gravity in phone axes = R^T e_z (R: phone -> ENU)
+    const Eigen::Quaterniond q(s.quat_xyzw[3], s.quat_xyzw[0], s.quat_xyzw[1], s.quat_xyzw[2]);
+    rv_up_phone_ = q.normalized().conjugate() * Eigen::Vector3d::UnitZ();
+    have_rv_up_ = true;
+  }
   const auto h = rotation_vector_heading_rad(s.quat_xyzw, reference_axis(), opt_.heading.min_horizontal);
   have_rv_ = true;
   if (!h) return;  // reference axis near vertical: keep propagating with the gyro
@@ -307,7 +424,7 @@ void Pdr::feed(const RotationVectorSample& s) {
   // nominal reading, never above it
   if (std::isfinite(s.heading_accuracy_rad) && s.heading_accuracy_rad > 0.0)
     w *= std::clamp(std::pow(opt_.fusion.base_sigma_rad / s.heading_accuracy_rad, 2), opt_.fusion.disturbed_weight, 1.0);
-  absolute_heading(s.t_ns, *h, w);
+  absolute_heading(s.t_ns, *h, w, HeadingSource::kRotationVector);
 }
 
 void Pdr::feed(const StepDetectorSample& s) {
@@ -315,6 +432,7 @@ void Pdr::feed(const StepDetectorSample& s) {
   if (c == SampleCheck::kDuplicate || c == SampleCheck::kBackwards) return;
   have_sd_last_ = true;
   sd_last_ns_ = s.t_ns;
+  ++sensors_.step_detector;
   latest_ns_ = std::max(latest_ns_, s.t_ns);
   android_step_times_.push_back(s.t_ns);
   have_android_ = true;
@@ -370,6 +488,10 @@ void Pdr::emit_step(const HeldStep& h) {
   distance_m_ += st.length_m;
   steps_.push_back(st);
   steps_magnetic_.push_back(h.magnetic ? 1 : 0);
+  if (source_spans_.empty() || source_spans_.back().source != h.source)
+    source_spans_.push_back({st.t_ns, st.t_ns, h.source, 0});
+  source_spans_.back().t_end_ns = std::max(source_spans_.back().t_end_ns, st.t_ns);
+  ++source_spans_.back().steps;
   ++step_count_;
 }
 

@@ -34,7 +34,7 @@ void PlacementEstimator::start_bout(TimeNs t_ns) {
   corr_.setZero();
   cov_h_.setZero();
   var_v_ = n_corr_ = walking_s_ = 0.0;
-  prior_supported_ = reversed_ = false;
+  prior_supported_ = reversed_ = prior_rejected_ = bout_levelled_ = false;
   // placement from the dominant gravity axis; the reference axis is the placement's prior
   // walking axis (flat: +Y, upright: -Z), else the most horizontal of +X, +Y, -Z
   const double ax = std::abs(up_.x()), ay = std::abs(up_.y()), az = std::abs(up_.z());
@@ -54,10 +54,32 @@ void PlacementEstimator::start_bout(TimeNs t_ns) {
   update_forward();
 }
 
+void PlacementEstimator::feed(const GyroSample& s) {
+  if (!s.rate_radps.allFinite()) return;
+  gyro_radps_ = s.rate_radps;
+  gyro_ns_ = s.t_ns;
+}
+
 void PlacementEstimator::feed(const AccelSample& s, bool walking) {
   if (!s.acc_mps2.allFinite()) return;
   if (have_last_ && s.t_ns <= last_ns_) return;
   const double dt = have_last_ ? ns_to_s(s.t_ns - last_ns_) : 0.0;
+  // tilt filter: gravity propagated with the gyro (a world-fixed vector moves as u x w in
+  // phone axes), pulled toward the measured specific force with time constant tilt_tau_s
+  const double a_norm = s.acc_mps2.norm();
+  const bool gyro_fresh = gyro_ns_ >= 0 && std::abs(ns_to_s(s.t_ns - gyro_ns_)) <= opt_.gyro_max_age_s;
+  const double dt_tilt = tilt_ns_ >= 0 ? ns_to_s(s.t_ns - tilt_ns_) : -1.0;
+  if (!gyro_fresh || a_norm < 1e-6) {
+    tilt_ok_ = false;
+  } else if (!tilt_ok_ || !(dt_tilt > 0.0) || dt_tilt > 0.5) {  // (re)start from the specific force
+    tilt_up_ = s.acc_mps2 / a_norm;
+    tilt_ok_ = true;
+  } else {
+    tilt_up_ += tilt_up_.cross(gyro_radps_) * dt_tilt;
+    tilt_up_ += std::min(1.0, dt_tilt / opt_.tilt_tau_s) * (s.acc_mps2 / a_norm - tilt_up_);
+    tilt_up_.normalize();
+  }
+  tilt_ns_ = s.t_ns;
   if (have_last_ && dt > 0.5) {  // a gap: statistics restart, the bout goes on
     win_.clear();
     sum_.setZero();
@@ -94,9 +116,15 @@ void PlacementEstimator::feed(const AccelSample& s, bool walking) {
   // linear acceleration, high-passed so that only the gait (>= ~1 Hz) enters the phase
   // correlation: a phone being tilted or lowered leaves a slow ramp in (a - 2 s mean) that
   // correlates with itself at any lag
-  const Eigen::Vector3d lin = gait_band(s.acc_mps2 - mean, dt);
-  const double av = lin.dot(up_);
-  const Eigen::Vector3d h = lin - av * up_;
+  // with the tilt filter: split about the instantaneous gravity (no tilt leaks into it); a
+  // flat phone keeps the 2 s mean: there the hand's pitch at the step frequency is part of the
+  // forward-phase signature (levelled, the sign of 3 of the 43 ILC walks flips, 2.44 -> 2.68 m)
+  const bool level = tilt_ok_ && bout_.placement != Placement::kFlat;
+  if (walking) bout_levelled_ = level;
+  const Eigen::Vector3d& u = level ? tilt_up_ : up_;
+  const Eigen::Vector3d lin = gait_band(level ? Eigen::Vector3d(s.acc_mps2 - mean.norm() * u) : Eigen::Vector3d(s.acc_mps2 - mean), dt);
+  const double av = lin.dot(u);
+  const Eigen::Vector3d h = lin - av * u;
   hist_.emplace_back(s.t_ns, h);
   const TimeNs lag_t = s.t_ns - s_to_ns(opt_.phase_lag_s);
   while (hist_.size() > 1 && hist_[1].first <= lag_t) hist_.pop_front();
@@ -115,6 +143,10 @@ double PlacementEstimator::flip_threshold() const {
   // the correlation of T seconds of gait scatters as 1/sqrt(T): a reversal of the prior needs
   // flip_corr at flip_settle_s of walking, proportionally more before
   const double t = std::max(walking_s_, 1e-3);
+  // a levelled bout (gyro-propagated tilt: pockets, at the ear) has no tilt leakage that could
+  // fake the phase: once settled the correlation's sign itself decides (its magnitude is
+  // 0.2-0.3 there, near flip_corr, against 0.25-0.5 for the unlevelled texting correlation)
+  if (bout_levelled_ && walking_s_ >= opt_.flip_settle_s) return 0.0;
   return opt_.flip_corr * std::max(1.0, std::sqrt(opt_.flip_settle_s / t));
 }
 
@@ -133,7 +165,19 @@ Eigen::Vector3d PlacementEstimator::gait_band(const Eigen::Vector3d& lin, double
 
 void PlacementEstimator::update_forward() {
   const bool trusted = walking_s_ >= opt_.min_bout_s && var_v_ > 0.0;
-  if (bout_.placement == Placement::kFlat || bout_.placement == Placement::kUpright) {
+  Eigen::Vector3d d = corr_ - corr_.dot(up_) * up_;  // the motion's direction (horizontal)
+  if (bout_.placement == Placement::kUpright) {
+    // the upright prior's line against the motion's (levelled) direction, once the correlation
+    // has settled; the flat prior stands (hand-held texting: the phone is held square to the
+    // body, and the unlevelled correlation's direction scatters 32 deg around it on ILC)
+    const Eigen::Vector3d prior_axis = -Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d ph = prior_axis - prior_axis.dot(up_) * up_;
+    if (trusted && walking_s_ >= opt_.prior_check_s && d.norm() > 1e-9 && ph.norm() > 0.2) {
+      const double cos_line = std::abs(d.normalized().dot(ph.normalized()));
+      prior_rejected_ = cos_line < std::cos(opt_.prior_max_angle_rad);
+    }
+  }
+  if (prior_applies()) {
     const Eigen::Vector3d prior = bout_.placement == Placement::kFlat ? Eigen::Vector3d(Eigen::Vector3d::UnitY())
                                                                       : Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
     double c = 0.0;
@@ -145,8 +189,7 @@ void PlacementEstimator::update_forward() {
     bout_.forward_phone = reversed_ ? Eigen::Vector3d(-prior) : prior;
     return;
   }
-  // other placements: the lagged correlation vector, horizontal part
-  Eigen::Vector3d d = corr_ - corr_.dot(up_) * up_;
+  // other placements (and a rejected prior): the lagged correlation vector, horizontal part
   if (trusted && d.norm() > 1e-9) {
     d.normalize();
     bout_.forward_phone = d;

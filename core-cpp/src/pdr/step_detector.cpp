@@ -143,7 +143,8 @@ std::optional<StepCandidate> StepDetector::on_symbol(Symbol sym, TimeNs t_ns, do
 }
 
 bool StepDetector::stride_like(TimeNs t_ns, double interval_s) const {
-  if (opt_.stride_harmonic_ratio <= 0.0 || interval_s < opt_.stride_min_interval_s ||
+  const double min_interval_s = running_ ? opt_.running_stride_min_interval_s : opt_.stride_min_interval_s;
+  if (opt_.stride_harmonic_ratio <= 0.0 || interval_s < min_interval_s ||
       interval_s > opt_.stride_max_interval_s) {
     return false;
   }

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <deque>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "pdnav/geo/events.h"
@@ -27,6 +28,23 @@ enum class StepSource {
   kAuto,           // Android events while they arrive (within android_timeout_s), else accelerometer
 };
 
+/// Where a step's heading came from (issue 27, reported per segment in replay's summary.json):
+/// the heading filter (HeadingFusion) is always gyro-propagated; this names the absolute
+/// reference that set its offset around the step. kRotationVector / kCompass: readings of that
+/// stream passed the field tests (recent mean weight >= PdrOptions::trusted_source_weight);
+/// kGyro: the field was disturbed around the step, the gyro carried the heading from earlier
+/// readings; kInitial: no absolute reading yet (the configured initial heading, gyro-propagated).
+enum class HeadingSource { kInitial, kGyro, kCompass, kRotationVector };
+const char* to_string(HeadingSource s);
+
+/// Consecutive emitted steps with one heading source.
+struct HeadingSourceSpan {
+  TimeNs t_start_ns = 0;
+  TimeNs t_end_ns = 0;
+  HeadingSource source = HeadingSource::kInitial;
+  std::int64_t steps = 0;
+};
+
 struct PdrOptions {
   StepDetectorOptions detector;  // APT Sec. V-A (+ gates)
   StepLengthModel length;        // APT Sec. V-A: l = c1 * height
@@ -43,6 +61,15 @@ struct PdrOptions {
   /// fraction over the window below.
   double consistency_tolerance = 0.10;
   double consistency_window_s = 30.0;
+  // Heading source report: mean weight of the absolute readings over the last source_tau_s
+  // (HeadingFusionOptions::decorrelation_s) at or above this = that stream is the source, below =
+  // the gyro (the weight is 1 for a reading passing the field tests, disturbed_weight otherwise).
+  double source_tau_s = 5.0;
+  double trusted_source_weight = 0.5;
+  /// An uncalibrated stream stands in for its calibrated twin once it has run this long without
+  /// it (GnssLogger logs carry both: the calibrated one is used, never a mix; some loggers
+  /// write only the uncalibrated ones).
+  double uncal_fallback_s = 1.0;
 };
 
 /// Sample counters by sensor and reason (skipped or reset).
@@ -64,6 +91,19 @@ struct PdrCounters {
   }
 };
 
+/// The sensors the PDR has been fed so far (issue 27, "every sensor set"): each stream counts
+/// when it was used. An uncalibrated stream (UncalAccel/UncalGyro/UncalMag, bias removed) is
+/// used only while its calibrated twin is absent (PdrOptions::uncal_fallback_s).
+struct PdrSensorSet {
+  std::int64_t accel = 0, gyro = 0, mag = 0, rotation_vector = 0, step_detector = 0;
+  std::int64_t uncal_accel = 0, uncal_gyro = 0, uncal_mag = 0;  // used in place of the calibrated ones
+  /// e.g. "accel+gyro+mag+rv", "rv+steps", "uncal accel+uncal gyro+uncal mag", "accel".
+  std::string name() const;
+  /// The absolute heading it can have: "rotation vector", "magnetometer", "none (gyro-relative
+  /// from the initial heading)" or "none".
+  std::string heading_reference() const;
+};
+
 /// Accelerometer detector vs Android step-detector events over the last consistency window.
 struct StepConsistency {
   std::int64_t accel_steps = 0;    // accelerometer steps in the window
@@ -81,6 +121,10 @@ class Pdr {
   void feed(const MagSample& s);
   void feed(const RotationVectorSample& s);
   void feed(const StepDetectorSample& s);
+  /// Uncalibrated streams (bias / drift removed): used only without the calibrated twin.
+  void feed(const UncalAccelSample& s);
+  void feed(const UncalGyroSample& s);
+  void feed(const UncalMagSample& s);
   /// Android sensor accuracy events: the magnetometer's (TYPE_MAGNETIC_FIELD 2 and its
   /// uncalibrated form 14) scales the weight of compass and rotation-vector headings
   /// (HeadingFusionOptions::accuracy_weight); other sensors' events are ignored.
@@ -125,6 +169,7 @@ class Pdr {
   const geo::Declination& declination() const { return declination_; }
   bool has_location() const { return has_location_; }
   PdrCounters counters() const;
+  const PdrSensorSet& sensor_set() const { return sensors_; }
   StepConsistency consistency() const;
   const PdrOptions& options() const { return opt_; }
   /// Placement bouts so far (time spans, placement, walking direction in phone axes); with a
@@ -135,6 +180,8 @@ class Pdr {
     return {classifier_.vehicle_spans().begin(), classifier_.vehicle_spans().end()};
   }
   MotionState motion_state() const { return classifier_.state(); }
+  /// The heading source of the emitted steps, as spans of consecutive steps.
+  const std::vector<HeadingSourceSpan>& heading_sources() const { return source_spans_; }
   /// Sum of the emitted step lengths (m).
   double distance_m() const { return distance_m_; }
 
@@ -150,6 +197,7 @@ class Pdr {
     Eigen::Vector3d reference_phone = Eigen::Vector3d::Zero();  // axis its heading refers to
     bool android = false;  // an Android step-detector event (emitted directly, no placement wait)
     bool handling_suspect = false;  // delivered while the rotation looked like handling starting
+    HeadingSource source = HeadingSource::kInitial;
   };
   HeldStep hold(const StepCandidate& c) const;
   void release(const std::vector<HeldStep>& steps, TimeNs now_ns);
@@ -173,8 +221,25 @@ class Pdr {
   bool android_active(TimeNs t_ns) const;
   void trim_consistency(TimeNs t_ns);
   Eigen::Vector3d reference_axis() const;
-  void absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight);
+  void absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight, HeadingSource kind);
+  HeadingSource heading_source(TimeNs t_ns) const;
   void sync_placement();
+  /// Without an accelerometer (a log of the fused sensors only): the reference axis from the
+  /// rotation vector's own gravity, the placement's prior (flat: +Y, upright: -Z).
+  Eigen::Vector3d rv_reference_axis() const;
+  PdrSensorSet sensors_;
+  bool have_accel_ = false;
+  bool have_rv_up_ = false;
+  Eigen::Vector3d rv_up_phone_ = Eigen::Vector3d::UnitZ();
+  TimeNs last_cal_accel_ns_ = -1, last_cal_gyro_ns_ = -1, last_cal_mag_ns_ = -1;
+  TimeNs first_uncal_accel_ns_ = -1, first_uncal_gyro_ns_ = -1, first_uncal_mag_ns_ = -1;
+  /// An uncalibrated sample is used once its stream has run uncal_fallback_s without its
+  /// calibrated twin (never mixed with it: a log with both uses the calibrated one only).
+  bool uncal_allowed(TimeNs t_ns, TimeNs last_calibrated_ns, TimeNs& first_uncal_ns) {
+    if (first_uncal_ns < 0) first_uncal_ns = t_ns;
+    const TimeNs since = last_calibrated_ns < 0 ? t_ns - first_uncal_ns : t_ns - last_calibrated_ns;
+    return ns_to_s(since) > opt_.uncal_fallback_s;
+  }
 
   PdrOptions opt_;
   StepDetector detector_;
@@ -218,6 +283,11 @@ class Pdr {
   std::vector<PdrStep> steps_;
   std::deque<HeldStep> undecided_;  // released, waiting for the walking direction
   std::vector<char> steps_magnetic_;  // per steps_ entry: heading still magnetic
+  // heading source: the latest absolute stream and the decayed mean weight of its readings
+  HeadingSource abs_kind_ = HeadingSource::kInitial;
+  double abs_weight_mean_ = 0.0;
+  TimeNs abs_weight_ns_ = -1;
+  std::vector<HeadingSourceSpan> source_spans_;
   std::int64_t step_count_ = 0;
   std::deque<TimeNs> accel_step_times_, android_step_times_;
   TimeNs last_android_ns_ = 0;

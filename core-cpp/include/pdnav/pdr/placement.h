@@ -13,6 +13,16 @@
 // "Comparison of misalignment estimation techniques between handheld device and walking
 // directions", IPIN 2015, use the same phase relation). For "other" placements the direction
 // is that lagged correlation vector itself, c = E[a_h(t) a_v(t + tau)] (no axis prior).
+// The vertical/horizontal split of each sample uses the instantaneous gravity direction of a
+// gyro-propagated tilt filter (complementary filter on the gravity vector, Mahony, Hamel,
+// Pflimlin, "Nonlinear complementary filters on the special orthogonal group", IEEE TAC 2008;
+// the rotation-matrix levelling of RMPCA, Deng et al., Sensors 2015): in a pocket or a
+// swinging hand the phone tilts by tens of degrees every stride, and with the 2 s mean as
+// "up" that tilt leaks gravity (9.8 sin(tilt) m/s^2) into the horizontal acceleration and
+// swamps the gait (pockets 30-160 deg off). Without a gyroscope, and for a flat phone (see
+// placement.cpp), the 2 s mean is used. The upright prior axis (-Z) stands only while the
+// motion's direction is within prior_max_angle_rad of its line (a phone at the ear or in a
+// trouser pocket is upright too, but walks along +-X or obliquely).
 // One constant offset per placement bout; a bout ends when the gravity direction in phone
 // axes moves by more than change_angle_rad for change_hold_s (the phone was moved).
 #pragma once
@@ -48,6 +58,14 @@ struct PlacementOptions {
   // ... but only while the motion contradicts the placement's prior axis: after this much
   // walking with a positive phase correlation along the prior, the prior stands (no wait).
   double prior_confirm_s = 0.5;
+  // Tilt filter: the gyro-propagated gravity is pulled toward the accelerometer with this time
+  // constant (Mahony et al. 2008: a crossover well below the gait, above gyro drift).
+  double tilt_tau_s = 1.0;
+  double gyro_max_age_s = 0.1;  // a gyro sample older than this is not used to propagate
+  // The upright prior axis is replaced by the motion's direction when that lies further than
+  // this from the prior's line, after this much walking (halfway between the axes).
+  double prior_max_angle_rad = 45 * kDegToRad;
+  double prior_check_s = 4.0;
 };
 
 /// A placement bout: from t_start_ns to t_end_ns (last sample so far for the open one).
@@ -65,6 +83,9 @@ class PlacementEstimator {
   /// Feeds one accelerometer sample (phone axes, m/s^2). walking: the caller's gate (steps
   /// are being counted), so the correlations only learn from gait.
   void feed(const AccelSample& s, bool walking);
+  /// Feeds one gyroscope sample (phone axes, rad/s): propagates the tilt between accelerometer
+  /// samples. Without gyroscope samples the 2 s mean of the accelerometer is "up".
+  void feed(const GyroSample& s);
   /// Ends the current bout (e.g. the phone was handled); the next sample starts a new one.
   void end_bout();
 
@@ -90,11 +111,17 @@ class PlacementEstimator {
   bool direction_known() const {
     if (!in_bout_) return false;
     // no prior axis (placement "other"): the direction is the correlation itself, trusted at min_bout_s
-    if (bout_.placement != Placement::kFlat && bout_.placement != Placement::kUpright) return walking_s_ >= opt_.min_bout_s;
+    if (!prior_applies()) return walking_s_ >= opt_.min_bout_s;
     if (prior_supported_) return walking_s_ >= opt_.prior_confirm_s;
     // the motion contradicts the prior: known once reversed, or once the evidence has settled
     return walking_s_ >= opt_.flip_settle_s || (walking_s_ >= opt_.min_bout_s && reversed_);
   }
+  /// The bout's prior axis (flat/upright) is in use: not replaced by the motion's direction.
+  bool prior_applies() const {
+    return (bout_.placement == Placement::kFlat || bout_.placement == Placement::kUpright) && !prior_rejected_;
+  }
+  /// The levelled tilt filter is running (gyroscope seen); "up" of the last sample.
+  bool levelled() const { return tilt_ok_; }
   /// Every bout so far (closed ones and the open one last).
   std::vector<PlacementBout> bouts() const;
 
@@ -128,6 +155,14 @@ class PlacementEstimator {
   Eigen::Matrix3d cov_h_ = Eigen::Matrix3d::Zero();
   double walking_s_ = 0.0;
   bool prior_supported_ = false;  // running phase correlation along the prior axis > 0
+  bool prior_rejected_ = false;   // the motion's direction is off the prior's line
+  bool bout_levelled_ = false;    // the bout's correlation is split about the tilt filter's gravity
+  // tilt filter (gravity direction in phone axes, gyro-propagated)
+  Eigen::Vector3d tilt_up_ = Eigen::Vector3d::UnitZ();
+  bool tilt_ok_ = false;
+  Eigen::Vector3d gyro_radps_ = Eigen::Vector3d::Zero();
+  TimeNs gyro_ns_ = -1;
+  TimeNs tilt_ns_ = -1;
 };
 
 }  // namespace pdnav::pdr
