@@ -146,7 +146,7 @@ void MotionClassifier::vehicle_sample(TimeNs t_ns, double acc_norm, const Eigen:
         }
         bins_.push_back(b);
         if (bins_.size() > window_bins) bins_.pop_front();
-        if (++bins_since_eval_ * opt_.vehicle_bin_s >= opt_.vehicle_eval_s - 1e-9 && bins_.size() == window_bins) {
+        if (static_cast<double>(++bins_since_eval_) * opt_.vehicle_bin_s >= opt_.vehicle_eval_s - 1e-9 && bins_.size() == window_bins) {
           bins_since_eval_ = 0;
           vehicle_evaluate(bin_origin_ns_ + (k + 1) * bin_ns);
         }
