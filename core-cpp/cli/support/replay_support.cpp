@@ -276,6 +276,13 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
   j["vehicle_spans"] = rides;
   j["magnetometer_readings_trusted"] = c.mag_readings_trusted;
   j["magnetometer_readings_disturbed"] = c.mag_readings_disturbed;
+  const pdr::MagCalibration& cal = pdr.mag_calibration();
+  j["mag_calibration"] = {{"active", cal.active()},
+                          {"bias_ut", {cal.bias_ut().x(), cal.bias_ut().y(), cal.bias_ut().z()}},
+                          {"radius_ut", std::isfinite(cal.radius_ut()) ? nlohmann::json(cal.radius_ut()) : nlohmann::json()},
+                          {"residual", std::isfinite(cal.residual()) ? nlohmann::json(cal.residual()) : nlohmann::json()},
+                          {"fits_accepted", cal.fits_accepted()},
+                          {"fits_refused", cal.refusals()}};
   nlohmann::json bouts = nlohmann::json::array();
   for (const pdr::PlacementBout& b : pdr.placements()) {
     bouts.push_back({{"placement", pdr::to_string(b.placement)},

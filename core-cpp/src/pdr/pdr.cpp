@@ -21,6 +21,7 @@ Pdr::Pdr(const PdrOptions& options)
       placement_(options.placement),
       fusion_(options.fusion),
       qsf_(options.fusion),
+      magcal_(options.magcal),
       fusion_reference_(placement_.reference_phone()) {}  // readings before the first bout use it
 
 void Pdr::set_location(const geo::Geodetic& where, std::int64_t utc_ms) {
@@ -372,14 +373,24 @@ void Pdr::feed(const MagSample& s) {
   if (c == SampleCheck::kNonFinite || c == SampleCheck::kDuplicate || c == SampleCheck::kBackwards) return;
   have_mag_last_ = true;
   mag_last_ns_ = s.t_ns;
-  last_field_ut_ = s.field_ut;
+  last_field_ut_ = s.field_ut;  // the rotation vector's weight tests the field it used: raw
   latest_ns_ = std::max(latest_ns_, s.t_ns);
+  magcal_.add(s.t_ns, s.field_ut);
+  const Eigen::Vector3d field_ut = magcal_.corrected(s.field_ut);  // hard iron removed
+  const bool rv_fresh = have_rv_ && ns_to_s(s.t_ns - last_rv_ns_) <= opt_.heading.rv_max_age_s;
+  if (opt_.magcal.restart_change_ut > 0.0 && !rv_fresh &&
+      (magcal_.bias_ut() - compass_bias_ut_).norm() >= opt_.magcal.restart_change_ut) {
+    // the compass offset was learned from readings with another bias: it restarts from these
+    fusion_.reset();
+    qsf_.reset();
+    compass_bias_ut_ = magcal_.bias_ut();
+  }
   if (!tracker_.has_gravity()) return;
   const auto compass =
-      compass_heading_rad(s.field_ut, tracker_.up_phone(), reference_axis(), opt_.heading.min_horizontal);
+      compass_heading_rad(field_ut, tracker_.up_phone(), reference_axis(), opt_.heading.min_horizontal);
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(s.t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
   if (compass && gyro_live) {
-    qsf_.add(s.t_ns, *compass + tracker_.yaw_rad(), s.field_ut.norm());
+    qsf_.add(s.t_ns, *compass + tracker_.yaw_rad(), field_ut.norm());
     ++counters_.mag_readings_qsf_tested;
     counters_.mag_readings_quasi_static += qsf_.quasi_static();
   } else {
@@ -388,7 +399,7 @@ void Pdr::feed(const MagSample& s) {
   if (have_rv_ && ns_to_s(s.t_ns - last_rv_ns_) <= opt_.heading.rv_max_age_s) return;  // RV wins
   if (!compass) return;
   absolute_heading(s.t_ns, *compass,
-                   qsf_weight() * mag_accuracy_weight_ * fusion_.field_weight(s.field_ut, tracker_.up_phone()),
+                   qsf_weight() * mag_accuracy_weight_ * fusion_.field_weight(field_ut, tracker_.up_phone()),
                    HeadingSource::kCompass);
 }
 

@@ -14,6 +14,7 @@
 #include "pdnav/geo/wmm.h"
 #include "pdnav/pdr/heading.h"
 #include "pdnav/pdr/heading_fusion.h"
+#include "pdnav/pdr/mag_calibration.h"
 #include "pdnav/pdr/motion_classifier.h"
 #include "pdnav/pdr/placement.h"
 #include "pdnav/pdr/step_detector.h"
@@ -50,6 +51,7 @@ struct PdrOptions {
   StepLengthModel length;        // APT Sec. V-A: l = c1 * height
   HeadingOptions heading;        // mount; APT Sec. V-B gyro re-orientation; fallbacks
   HeadingFusionOptions fusion;   // gyro-dominant heading, magnetic readings gated against WMM
+  MagCalibrationOptions magcal;  // online hard-iron sphere fit (Vasconcelos et al. 2011)
   PlacementOptions placement;    // placement + walking direction when heading.mount == kAuto
   MotionClassifierOptions motion;  // walking / standing / handling
   bool gate_handling = true;     // no steps while the phone is handled or waved
@@ -180,6 +182,8 @@ class Pdr {
     return {classifier_.vehicle_spans().begin(), classifier_.vehicle_spans().end()};
   }
   MotionState motion_state() const { return classifier_.state(); }
+  /// Online hard-iron calibration of the magnetometer feeding the compass (bias in use, active).
+  const MagCalibration& mag_calibration() const { return magcal_; }
   /// The heading source of the emitted steps, as spans of consecutive steps.
   const std::vector<HeadingSourceSpan>& heading_sources() const { return source_spans_; }
   /// Sum of the emitted step lengths (m).
@@ -251,6 +255,8 @@ class Pdr {
   PlacementEstimator placement_;
   HeadingFusion fusion_;
   QuasiStaticField qsf_;
+  MagCalibration magcal_;
+  Eigen::Vector3d compass_bias_ut_ = Eigen::Vector3d::Zero();  // hard iron the compass offset was learned with
   Eigen::Vector3d fusion_reference_;  // the reference axis fusion_'s offset refers to
   double qsf_weight() const { return qsf_.quasi_static() ? 1.0 : opt_.fusion.non_qsf_weight; }
   std::int64_t placement_revision_ = 0;
