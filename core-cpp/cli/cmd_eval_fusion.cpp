@@ -26,6 +26,7 @@
 #include "pdnav/route/walk_graph.h"
 #include "pdnav/terrain/dem.h"
 #include "pdnav/terrain/simulator.h"
+#include "support/eval_support.h"
 
 namespace pdnav::cli {
 namespace {
@@ -51,14 +52,6 @@ struct Track {
   std::vector<Eigen::Vector2d> en_m;
   std::vector<Eigen::Matrix2d> cov;
 };
-
-double median(std::vector<double> v) {
-  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
-  if (v.empty()) return kNaNd;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 /// The session through the log writer and reader (in memory, the same text as a file).
 std::vector<Sample> through_log(const std::vector<Sample>& samples, std::size_t* skipped) {
@@ -252,18 +245,8 @@ WalkResult evaluate(const phonesim::PhoneSession& ses, const fusion::NavigatorCo
   return r;
 }
 
-std::string f1(double v) {
-  if (!std::isfinite(v)) return "-";
-  char b[32];
-  std::snprintf(b, sizeof b, "%.1f", v);
-  return b;
-}
-std::string f3(double v) {
-  if (!std::isfinite(v)) return "nan";
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3f", v);
-  return b;
-}
+std::string f1(double v) { return fixed_or(v, 1, "-"); }  // '-' = no valid estimate (the table's legend)
+std::string f3(double v) { return fixed_or(v, 3, "nan"); }
 
 int run_eval_fusion(const EvalFusionArgs& a) {
   if (a.walks < 1) throw std::invalid_argument("--walks must be >= 1");
@@ -282,8 +265,7 @@ int run_eval_fusion(const EvalFusionArgs& a) {
   base.graph = graph;
   base.ephemeris = eph_c;
   base.particles = a.particles;
-  if (a.fusion_model == "issue14") base.fusion = fusion::fusion_options_before_issue28();
-  else if (a.fusion_model != "issue28") throw std::invalid_argument("--fusion-model: issue28 (default) or issue14");
+  apply_fusion_model(a.fusion_model, base.fusion);
 
   phonesim::SessionOptions so;
   so.outage_min_s = 60.0 * a.outage_min_min;
@@ -349,18 +331,18 @@ int run_eval_fusion(const EvalFusionArgs& a) {
     open.push_back(r.open_sky_ratio);
     for (int e = 0; e < 5; ++e) e_out[e].push_back(r.out[e].drms_m), e_after[e].push_back(r.after[e].drms_m);
   }
-  std::printf("median DRMS during outages (m): fused %s dr %s gnss %s terrain %s route %s\n", f1(median(e_out[0])).c_str(),
-              f1(median(e_out[1])).c_str(), f1(median(e_out[2])).c_str(), f1(median(e_out[3])).c_str(),
-              f1(median(e_out[4])).c_str());
-  std::printf("median DRMS after outages (m):  fused %s dr %s gnss %s terrain %s route %s\n", f1(median(e_after[0])).c_str(),
-              f1(median(e_after[1])).c_str(), f1(median(e_after[2])).c_str(), f1(median(e_after[3])).c_str(),
-              f1(median(e_after[4])).c_str());
+  auto med = [](const std::vector<double>& v) { return f1(median_of_finite(v)); };
+  std::printf("median DRMS during outages (m): fused %s dr %s gnss %s terrain %s route %s\n", med(e_out[0]).c_str(),
+              med(e_out[1]).c_str(), med(e_out[2]).c_str(), med(e_out[3]).c_str(), med(e_out[4]).c_str());
+  std::printf("median DRMS after outages (m):  fused %s dr %s gnss %s terrain %s route %s\n", med(e_after[0]).c_str(),
+              med(e_after[1]).c_str(), med(e_after[2]).c_str(), med(e_after[3]).c_str(), med(e_after[4]).c_str());
   const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("walks: %zu run_time_s: %.1f fused coverage_68 in outages (pooled): %s\n", results.size(), run_s,
               f3(scored > 0 ? static_cast<double>(covered) / scored : kNaNd).c_str());
   const double max_jump = *std::max_element(jump.begin(), jump.end());
-  std::printf("outage_ratio: %s max_jump_sigma: %s reacquire_s: %s open_sky_ratio: %s\n", f3(median(ratio)).c_str(),
-              f3(max_jump).c_str(), f3(median(reacq)).c_str(), f3(median(open)).c_str());
+  std::printf("outage_ratio: %s max_jump_sigma: %s reacquire_s: %s open_sky_ratio: %s\n",
+              f3(median_of_finite(ratio)).c_str(), f3(max_jump).c_str(), f3(median_of_finite(reacq)).c_str(),
+              f3(median_of_finite(open)).c_str());
   return 0;
 }
 
@@ -382,9 +364,7 @@ void register_eval_fusion(CLI::App& app) {
   c->add_option("--lead", a->lead_s, "open-sky GNSS before the outage, s")->capture_default_str();
   c->add_option("--tail", a->tail_s, "walking after the outage, s")->capture_default_str();
   c->add_option("--particles", a->particles, "terrain particle count")->capture_default_str();
-  c->add_option("--fusion-model", a->fusion_model,
-                "fused covariance model: issue28 (default) | issue14 (before issue 28, for before/after figures)")
-      ->capture_default_str();
+  add_fusion_model_option(c, a->fusion_model);
   c->add_flag("--quiet", a->quiet, "no progress on stderr");
   c->callback([a]() { run_eval_fusion(*a); });
 }

@@ -29,6 +29,7 @@
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/route/walk_graph.h"
 #include "pdnav/terrain/dem.h"
+#include "support/eval_support.h"
 #include "support/replay_support.h"
 #include "support/sources.h"
 
@@ -97,26 +98,8 @@ double fix_sigma(const FixSample& f) {
   return (std::isfinite(f.accuracy_m) && f.accuracy_m > 0.0 ? f.accuracy_m : 15.0) * kAccuracyToSigma;
 }
 
-std::string f1(double v) {
-  if (!std::isfinite(v)) return "nan";
-  char b[32];
-  std::snprintf(b, sizeof b, "%.1f", v);
-  return b;
-}
-std::string f3(double v) {
-  if (!std::isfinite(v)) return "nan";
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3f", v);
-  return b;
-}
-
-double median(std::vector<double> v) {
-  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
-  if (v.empty()) return kNaNd;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+std::string f1(double v) { return fixed_or(v, 1, "nan"); }
+std::string f3(double v) { return fixed_or(v, 3, "nan"); }
 
 fusion::NavigatorConfig make_config(const EvalOutageArgs& a, fusion::EngineMode mode,
                                     const std::shared_ptr<const terrain::Dem>& dem,
@@ -129,8 +112,7 @@ fusion::NavigatorConfig make_config(const EvalOutageArgs& a, fusion::EngineMode 
   c.ephemeris = eph;
   c.user_height_m = a.height_m;
   c.mount = pdr::mount_from_string(a.mount);
-  if (a.fusion_model == "issue14") c.fusion = fusion::fusion_options_before_issue28();
-  else if (a.fusion_model != "issue28") throw std::invalid_argument("--fusion-model: issue28 (default) or issue14");
+  apply_fusion_model(a.fusion_model, c.fusion);
   return c;
 }
 
@@ -425,9 +407,9 @@ int run_eval_outage(const EvalOutageArgs& a) {
   }
   const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("run_time_s: %.1f%s\n", run_s, out.empty() ? "" : (" per-walk CSV/JSON: " + out.string()).c_str());
-  std::printf("outage_ratio: %s outage_rms_m: %s coverage_68: %s max_jump_sigma: %s walks: %zu\n", f3(median(ratio)).c_str(),
-              f1(median(rms)).c_str(), f3(epochs > 0 ? static_cast<double>(covered) / epochs : kNaNd).c_str(),
-              f3(jump).c_str(), results.size());
+  std::printf("outage_ratio: %s outage_rms_m: %s coverage_68: %s max_jump_sigma: %s walks: %zu\n",
+              f3(median_of_finite(ratio)).c_str(), f1(median_of_finite(rms)).c_str(),
+              f3(epochs > 0 ? static_cast<double>(covered) / epochs : kNaNd).c_str(), f3(jump).c_str(), results.size());
   return 0;
 }
 
@@ -455,9 +437,7 @@ void register_eval_outage(CLI::App& app) {
   c->add_option("--mount", a->mount, "phone placement (as pdnav replay)")->capture_default_str();
   c->add_option("--height", a->height_m, "user height, m (default: the log's, else unknown)");
   c->add_option("--seed", a->seed, "random seed")->capture_default_str();
-  c->add_option("--fusion-model", a->fusion_model,
-                "fused covariance model: issue28 (default) | issue14 (before issue 28, for before/after figures)")
-      ->capture_default_str();
+  add_fusion_model_option(c, a->fusion_model);
   c->add_flag("--quiet", a->quiet, "no progress on stderr");
   c->callback([a]() { run_eval_outage(*a); });
 }

@@ -67,6 +67,14 @@ bool load_classes(JNIEnv* env, ClassCache& c) {
   return c.estimate_ctor != nullptr && c.output_ctor != nullptr;
 }
 
+/// f(object) under the handle's lock, returned by value: the result is a copy taken under the
+/// lock, converted to Java objects after it is released.
+template <class T, class F>
+auto copy_locked(Handle<T>& h, F f) {
+  const std::lock_guard<std::mutex> lock(h.mutex);
+  return f(h.object);
+}
+
 jobject new_estimate(JNIEnv* env, const Estimate& e) {
   jclass c = g_classes.estimate;
   jmethodID ctor = g_classes.estimate_ctor;
@@ -185,11 +193,7 @@ void nav_set_start(JNIEnv* env, jclass, jlong handle, jdouble lat, jdouble lon, 
 jobject nav_estimate(JNIEnv* env, jclass, jlong handle) {
   return guarded<jobject>(env, nullptr, [&] {
     auto& h = from_handle<fusion::Navigator>(handle, "NativeNavigator");
-    Estimate e;
-    {
-      const std::lock_guard<std::mutex> lock(h.mutex);
-      e = h.object.estimate();
-    }
+    const Estimate e = copy_locked(h, [](fusion::Navigator& n) { return n.estimate(); });
     return new_estimate(env, e);
   });
 }
@@ -198,11 +202,8 @@ jobject nav_output(JNIEnv* env, jclass, jlong handle, jint max_particles) {
   return guarded<jobject>(env, nullptr, [&] {
     auto& h = from_handle<fusion::Navigator>(handle, "NativeNavigator");
     if (max_particles < 0) throw JavaError(kIllegalArgument, "maxParticles must be >= 0");
-    fusion::NavigatorOutput out;
-    {
-      const std::lock_guard<std::mutex> lock(h.mutex);
-      out = h.object.output(static_cast<std::size_t>(max_particles));
-    }
+    const fusion::NavigatorOutput out =
+        copy_locked(h, [&](fusion::Navigator& n) { return n.output(static_cast<std::size_t>(max_particles)); });
     jobject best = new_estimate(env, out.estimate);
     jobjectArray engines =
         env->NewObjectArray(static_cast<jsize>(out.engines.size()), g_classes.estimate, nullptr);
@@ -228,11 +229,8 @@ jobject nav_output(JNIEnv* env, jclass, jlong handle, jint max_particles) {
 jobjectArray nav_ignored(JNIEnv* env, jclass, jlong handle) {
   return guarded<jobjectArray>(env, nullptr, [&] {
     auto& h = from_handle<fusion::Navigator>(handle, "NativeNavigator");
-    std::vector<std::pair<std::string, std::int64_t>> ign;
-    {
-      const std::lock_guard<std::mutex> lock(h.mutex);
-      ign = h.object.ignored();
-    }
+    const std::vector<std::pair<std::string, std::int64_t>> ign =
+        copy_locked(h, [](fusion::Navigator& n) { return n.ignored(); });
     std::vector<std::string> flat;  // reason, count, reason, count, ...
     for (const auto& [reason, count] : ign) {
       flat.push_back(reason);
@@ -246,11 +244,8 @@ jobjectArray nav_ignored(JNIEnv* env, jclass, jlong handle) {
 jobjectArray nav_mode_changes(JNIEnv* env, jclass, jlong handle) {
   return guarded<jobjectArray>(env, nullptr, [&] {
     auto& h = from_handle<fusion::Navigator>(handle, "NativeNavigator");
-    std::vector<fusion::ModeChange> changes;
-    {
-      const std::lock_guard<std::mutex> lock(h.mutex);
-      changes = h.object.mode_changes();
-    }
+    const std::vector<fusion::ModeChange> changes =
+        copy_locked(h, [](fusion::Navigator& n) { return n.mode_changes(); });
     std::vector<std::string> flat;
     for (const fusion::ModeChange& c : changes) {
       flat.push_back(std::to_string(c.t_ns));
@@ -272,11 +267,8 @@ constexpr std::size_t kStepDoubles = 8;
 jdoubleArray nav_take_steps(JNIEnv* env, jclass, jlong handle) {
   return guarded<jdoubleArray>(env, nullptr, [&] {
     auto& h = from_handle<fusion::Navigator>(handle, "NativeNavigator");
-    std::vector<fusion::StepEstimate> steps;
-    {
-      const std::lock_guard<std::mutex> lock(h.mutex);
-      steps = h.object.take_steps();
-    }
+    const std::vector<fusion::StepEstimate> steps =
+        copy_locked(h, [](fusion::Navigator& n) { return n.take_steps(); });
     const double nan = std::nan("");
     std::vector<double> flat;
     flat.reserve(steps.size() * kStepDoubles);

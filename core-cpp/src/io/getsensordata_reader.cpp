@@ -17,6 +17,7 @@
 
 #include "io/line_source.h"
 #include "io/readers.h"
+#include "io/skip_reasons.h"
 #include "io/table_source.h"
 #include "io/text.h"
 #include "pdnav/io/log_format.h"
@@ -25,14 +26,8 @@ namespace pdnav::io::detail {
 
 namespace {
 
-constexpr const char* kNonNumeric = "non-numeric value";
 constexpr const char* kNonFinite = "non-finite value";
-constexpr const char* kFieldCount = "too few fields";
-constexpr const char* kInvalidTime = "invalid time";
-constexpr const char* kBackwards = "time went backwards";
-constexpr const char* kOutOfRange = "value out of range";
-constexpr const char* kTorn = "torn last line";
-constexpr const char* kTooLong = "line too long";
+constexpr const char* kTooFewFields = "too few fields";
 constexpr std::size_t kMaxDistinct = 64;
 
 /// A column name without its unit and spaces, lower case: "Acc_X(m/s^2)" -> "acc_x".
@@ -179,7 +174,7 @@ class GsdSource : public SampleSource {
 
   double num(const std::vector<std::string_view>& f, int i, const char* what, bool required = true) {
     if (i < 0 || static_cast<std::size_t>(i + 1) >= f.size()) {
-      if (required) throw RowSkip{kFieldCount, std::string("no ") + what + " field (" + std::to_string(f.size()) + " fields)"};
+      if (required) throw RowSkip{kTooFewFields, std::string("no ") + what + " field (" + std::to_string(f.size()) + " fields)"};
       return kNaN;
     }
     const std::string_view s = trim(f[static_cast<std::size_t>(i + 1)]);
@@ -263,7 +258,7 @@ class GsdSource : public SampleSource {
       PressureSample p;
       p.t_ns = line_time(type, l, fields_, true);
       const int c = l["pres"];
-      if (c < 0 || static_cast<std::size_t>(c + 1) >= fields_.size()) throw RowSkip{kFieldCount, "no Pres field"};
+      if (c < 0 || static_cast<std::size_t>(c + 1) >= fields_.size()) throw RowSkip{kTooFewFields, "no Pres field"};
       double pa = 0.0;
       const std::string_view txt = trim(fields_[static_cast<std::size_t>(c + 1)]);
       if (!parse_f64_pow10(txt, 2, pa)) throw RowSkip{kNonNumeric, "Pres '" + printable(txt) + "'"};

@@ -13,6 +13,7 @@
 
 #include "io/line_source.h"
 #include "io/schema.h"
+#include "io/skip_reasons.h"
 #include "io/text.h"
 #include "pdnav/geo/time.h"
 #include "pdnav/io/log_format.h"
@@ -40,17 +41,10 @@ std::int64_t ReadStats::skipped_total() const {
 namespace detail {
 namespace {
 
-// Skip reason categories (the keys of ReadStats::skipped_by_reason).
-constexpr const char* kWrongFieldCount = "wrong field count";
-constexpr const char* kNonNumeric = "non-numeric value";
-constexpr const char* kOutOfRange = "value out of range";
-constexpr const char* kInvalidTime = "invalid time";
+// Skip reason categories of this format only (the shared ones: io/skip_reasons.h).
 constexpr const char* kBadEscape = "bad percent escape";
-constexpr const char* kBackwards = "time went backwards";
 constexpr const char* kNoBase = "no elapsed-time base yet";
 constexpr const char* kNoTime = "no time in line";
-constexpr const char* kTorn = "torn last line";
-constexpr const char* kTooLong = "line too long";
 constexpr std::size_t kMaxDistinctKeys = 64;  // bounds maps fed by file content
 
 /// Why a line was skipped. `malformed` lines throw in strict mode; the others never do.
@@ -59,24 +53,6 @@ struct LineError {
   std::string detail;
   bool malformed = true;
 };
-
-/// Printable, bounded excerpt of file content for messages.
-std::string excerpt(std::string_view s, std::size_t max = 40) {
-  std::string out;
-  for (char c : s.substr(0, max)) {
-    const auto u = static_cast<unsigned char>(c);
-    out.push_back(u < 0x20 || u >= 0x7f ? '?' : c);
-  }
-  if (s.size() > max) out += "...";
-  return out;
-}
-
-std::string lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out)
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-  return out;
-}
 
 bool checked_mul(std::int64_t a, std::int64_t b, std::int64_t& out) { return !__builtin_mul_overflow(a, b, &out); }
 bool checked_add(std::int64_t a, std::int64_t b, std::int64_t& out) { return !__builtin_add_overflow(a, b, &out); }
@@ -108,7 +84,7 @@ template <class S> const std::vector<std::string>& canonical_names() {
     NameCollector c;
     S s;
     visit_fields(s, c);
-    for (std::string& n : c.names) n = lower(n);  // header matching is case-insensitive
+    for (std::string& n : c.names) n = lower_ascii(n);  // header matching is case-insensitive
     return std::move(c.names);
   }();
   return kNames;
@@ -121,7 +97,7 @@ template <class S> Schema make_schema(const std::vector<std::string>& header) {
   sc.n_cols = static_cast<int>(header.size());
   sc.slot_col.assign(canon.size(), -1);
   for (int col = 1; col < sc.n_cols; ++col) {
-    const std::string name = lower(trim(header[static_cast<std::size_t>(col)]));
+    const std::string name = lower_ascii(trim(header[static_cast<std::size_t>(col)]));
     if (name == "elapsedrealtimemillis") { sc.elapsed_ms_col = col; continue; }
     auto slot_of = [&](std::string_view n) {
       auto it = std::find(canon.begin(), canon.end(), n);
@@ -220,7 +196,7 @@ class FieldReader {
   std::string_view next() { return column(sc_.slot_col[static_cast<std::size_t>(slot_++)]); }
   [[noreturn]] static void fail(const char* category, std::string_view name, std::string_view f,
                                 const char* what) {
-    throw LineError{category, std::string(name) + " '" + excerpt(f) + "' " + what};
+    throw LineError{category, std::string(name) + " '" + printable(f) + "' " + what};
   }
 
   const Schema& sc_;
@@ -333,7 +309,7 @@ void ReaderCore::skip(const LineError& e) {
 }
 
 std::string ReaderCore::unknown_type_reason(std::string_view token) {
-  std::string reason = "unknown line type '" + excerpt(token, 24) + "'";
+  std::string reason = "unknown line type '" + printable(token, 24) + "'";
   if (stats_.skipped_by_reason.count(reason) > 0) return reason;
   if (unknown_types_ >= kMaxDistinctKeys) return "unknown line type (more names)";
   ++unknown_types_;
@@ -356,11 +332,11 @@ void ReaderCore::info_line(std::string_view text) {
     const std::string_view tok = text.substr(i, j - i);
     if (tok.size() > 1 && tok.back() == ':') {
       flush();
-      key = excerpt(tok.substr(0, tok.size() - 1), 64);
+      key = printable(tok.substr(0, tok.size() - 1), 64);
       value.clear();
     } else if (!tok.empty()) {
       if (!value.empty()) value.push_back(' ');
-      value += excerpt(tok, 256);
+      value += printable(tok, 256);
     }
     i = j;
   }
@@ -473,7 +449,7 @@ template <std::size_t I> void ReaderCore::parse_as(Sample& out) {
     std::int64_t ms = 0;
     const std::string_view f = trim(reader.column(sc.elapsed_ms_col));
     if (!f.empty()) {
-      if (!parse_i64(f, ms)) throw LineError{kInvalidTime, "ElapsedRealtimeMillis '" + excerpt(f) + "' is not an integer"};
+      if (!parse_i64(f, ms)) throw LineError{kInvalidTime, "ElapsedRealtimeMillis '" + printable(f) + "' is not an integer"};
       reader.times.elapsed_ms = ms;
     }
   }

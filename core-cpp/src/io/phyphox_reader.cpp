@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "io/readers.h"
+#include "io/skip_reasons.h"
 #include "io/table_source.h"
 #include "io/text.h"
 
@@ -17,11 +18,7 @@ namespace pdnav::io::detail {
 
 namespace {
 
-constexpr const char* kNonNumeric = "non-numeric value";
 constexpr const char* kNaNRow = "NaN (a shorter column's padding)";
-constexpr const char* kFieldCount = "wrong field count";
-constexpr const char* kOutOfRange = "value out of range";
-constexpr const char* kInvalidTime = "invalid time";
 
 /// A number in the export's notation: decimal comma when the separator is not ','.
 bool number(std::string_view s, char sep, double& out) {
@@ -188,6 +185,17 @@ Layout layout_of(const TableFile& f) {
   return l;
 }
 
+/// Next row of a meta/ table, passing over rows that next_row rejects (torn, over-long): they
+/// carry no metadata and are not counted. False at the end of the file.
+bool next_meta_row(TableFile& f) {
+  for (;;) {
+    try {
+      return f.next_row();
+    } catch (const RowSkip&) {
+    }
+  }
+}
+
 class PhyphoxBuilder {
  public:
   PhyphoxBuilder(std::unique_ptr<Container> c, SourceOptions opt) : c_(std::move(c)), opt_(opt) {}
@@ -225,14 +233,7 @@ class PhyphoxBuilder {
       const int k = f.column("property"), v = f.column("value");
       if (k < 0 || v < 0) throw IoError(f.where(), 1, "meta/device.csv without \"property\",\"value\" header");
       std::string model, brand, manufacturer;
-      for (;;) {
-        bool row = false;
-        try {
-          row = f.next_row();
-        } catch (const RowSkip&) {
-          continue;
-        }
-        if (!row) break;
+      while (next_meta_row(f)) {
         const std::string key = printable(f.field(k), 64), val = printable(f.field(v), 256);
         if (key.find(' ') != std::string::npos) continue;  // per-sensor rows ("accelerometer Resolution")
         if (info.size() < 64) info[key] = val;
@@ -250,14 +251,7 @@ class PhyphoxBuilder {
       const int ev = f.column("event"), et = f.column("experiment time"), sy = f.column("system time");
       if (ev < 0 || et < 0 || sy < 0)
         throw IoError(f.where(), 1, "meta/time.csv without \"event\",\"experiment time\",\"system time\" header");
-      for (;;) {
-        bool row = false;
-        try {
-          row = f.next_row();
-        } catch (const RowSkip&) {
-          continue;
-        }
-        if (!row) break;
+      while (next_meta_row(f)) {
         double x = 0;
         std::int64_t sys_ns = 0;
         if (!number(f.field(et), f.sep(), x) || !std::isfinite(x) || !unix_text_ns(f.field(sy), f.sep(), sys_ns))
@@ -287,7 +281,7 @@ class PhyphoxBuilder {
     const TimeMap tm = time_;
     src_->add(std::move(f), [l, tm](const TableFile& t, Sample& out) {
       if (t.n_fields() != t.header().size())
-        throw RowSkip{kFieldCount, std::to_string(t.n_fields()) + " fields, header has " + std::to_string(t.header().size())};
+        throw RowSkip{kWrongFieldCount, std::to_string(t.n_fields()) + " fields, header has " + std::to_string(t.header().size())};
       auto get = [&](int col) {
         double v = 0.0;
         if (col < 0) return kNaN;

@@ -3,33 +3,11 @@
 #include <algorithm>
 #include <limits>
 
+#include "io/skip_reasons.h"
 #include "io/text.h"
 #include "pdnav/io/log_format.h"
 
 namespace pdnav::io::detail {
-
-namespace {
-constexpr const char* kTorn = "torn last line";
-constexpr const char* kTooLong = "line too long";
-constexpr const char* kBackwards = "time went backwards";
-}  // namespace
-
-std::string lower_ascii(std::string_view s) {
-  std::string out(s);
-  for (char& c : out)
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-  return out;
-}
-
-std::string printable(std::string_view s, std::size_t max) {
-  std::string out;
-  for (char c : s.substr(0, max)) {
-    const auto u = static_cast<unsigned char>(c);
-    out.push_back(u < 0x20 || u >= 0x7f ? '?' : c);
-  }
-  if (s.size() > max) out += "...";
-  return out;
-}
 
 void split_fields(std::string_view line, char sep, std::vector<std::string>& out) {
   out.clear();

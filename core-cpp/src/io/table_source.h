@@ -26,9 +26,6 @@ struct RowSkip {
 
 /// Splits one line at `sep`, removing double quotes around fields ("" inside quotes is a quote).
 void split_fields(std::string_view line, char sep, std::vector<std::string>& out);
-std::string lower_ascii(std::string_view s);
-/// Printable, bounded excerpt of file content for messages.
-std::string printable(std::string_view s, std::size_t max = 40);
 
 /// One CSV table (a sensor file): header row, then data rows.
 class TableFile {

@@ -11,6 +11,11 @@ namespace pdnav::io::detail {
 
 /// Strips spaces and tabs at both ends.
 std::string_view trim(std::string_view s);
+/// ASCII letters to lower case; other bytes unchanged.
+std::string lower_ascii(std::string_view s);
+/// Printable, bounded excerpt of file content for messages: control and non-ASCII bytes as
+/// '?', at most `max` bytes, "..." when cut.
+std::string printable(std::string_view s, std::size_t max = 40);
 
 /// Parses a whole field as int64. Accepts an optional '-' and digits; as a fallback a
 /// decimal with zero fraction whose magnitude is <= 2^53 (e.g. "129.0"). False otherwise.
