@@ -11,6 +11,7 @@ void DeadReckoning::initialize(const geo::Geodetic& start, double sigma_m, TimeN
   p_.setZero();
   p_(0, 0) = p_(1, 1) = sigma_m * sigma_m;
   p_(2, 2) = opt_.heading_bias_sigma_rad * opt_.heading_bias_sigma_rad;
+  p_(3, 3) = opt_.length_scale_sigma * opt_.length_scale_sigma;
   t_ns_ = t_ns;
   initialized_ = true;
   have_steps_ = false;
@@ -45,21 +46,24 @@ void DeadReckoning::feed(const PdrStep& step) {
     rotation_sigma_rad_ = std::min(step.heading_sigma_rad, kPi);
   }
   have_steps_ = true;
-  const double l = step.length_m, h = step.heading_rad + x_(2);
+  const double l0 = step.length_m, l = (1.0 + x_(3)) * l0, h = step.heading_rad + x_(2);
   const double s = std::sin(h), c = std::cos(h);
   x_(0) += l * s;
   x_(1) += l * c;
   // FOGM bias: b' = phi b + w, phi = exp(-dt/tau), var(w) = sigma^2 (1 - phi^2)
   const double phi = std::exp(-dt / opt_.heading_bias_tau_s);
   x_(2) *= phi;
-  Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
+  Eigen::Matrix4d f = Eigen::Matrix4d::Identity();
   f(0, 2) = l * c;
   f(1, 2) = -l * s;
   f(2, 2) = phi;
+  f(0, 3) = l0 * s;  // the scale error moves every step along its own direction
+  f(1, 3) = l0 * c;
   const double sl = std::isfinite(step.length_sigma_m) && step.length_sigma_m > 0 ? step.length_sigma_m : opt_.length_sigma_m;
-  Eigen::Matrix3d q = Eigen::Matrix3d::Zero();
+  Eigen::Matrix4d q = Eigen::Matrix4d::Zero();
   q.topLeftCorner<2, 2>() = sl * sl * (Eigen::Vector2d(s, c) * Eigen::Vector2d(s, c).transpose());
   q(2, 2) = bias_sigma * bias_sigma * (1.0 - phi * phi);
+  q(3, 3) = opt_.length_scale_rw_1ps * dt;
   p_ = f * p_ * f.transpose() + q;
 }
 

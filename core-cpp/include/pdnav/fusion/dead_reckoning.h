@@ -1,5 +1,5 @@
 // Dead reckoning from PDR steps: the baseline every other engine is measured against.
-// A 3-state EKF [east, north, heading bias] whose bias is first-order Gauss-Markov as in
+// A 4-state EKF [east, north, heading bias, step scale error] whose bias is first-order Gauss-Markov as in
 // Broyles et al., Sensors 2018, Eq. 3-4 (sigma_theta 15 deg, tau_theta 60 s); no measurements,
 // so the mean is plain dead reckoning and the covariance grows the way the bias makes it.
 // Issue 19.1: each step's own heading sigma (from the PDR) sets the bias' spread at that step,
@@ -18,6 +18,12 @@ struct DeadReckoningOptions {
   double heading_bias_sigma_rad = 15.0 * kDegToRad;  // Broyles 2018, Table 1
   double heading_bias_tau_s = 60.0;                   // Broyles 2018, Table 1
   double length_sigma_m = 0.15;                       // Broyles 2018, sigma_l
+  // Issue 28: the walker's step-length scale error is a per-walk constant (stride vs the
+  // population model, grade, fatigue), not white per step: a random constant with the
+  // population spread of the height model (APT 1-sigma 10 %, Zhu 2015 Sec. V-C, the fused
+  // filter's initial_scale_sigma) plus the fused filter's (1 %)^2/min random walk. 0 = white only.
+  double length_scale_sigma = 0.10;
+  double length_scale_rw_1ps = 1e-4 / 60.0;
   // Per-step heading sigma (issue 19.1; docs/pdr.md "Dead-reckoning ellipse"). A step whose
   // PdrStep::heading_sigma_rad is below absolute_heading_max_sigma_rad has an absolute
   // heading: its sigma replaces heading_bias_sigma_rad as the bias' stationary sigma (the EKF's
@@ -46,8 +52,8 @@ class DeadReckoning {
   DeadReckoningOptions opt_;
   bool initialized_ = false;
   geo::LocalFrame frame_;
-  Eigen::Vector3d x_ = Eigen::Vector3d::Zero();  // e, n, heading bias
-  Eigen::Matrix3d p_ = Eigen::Matrix3d::Zero();
+  Eigen::Vector4d x_ = Eigen::Vector4d::Zero();  // e, n, heading bias, step-length scale error
+  Eigen::Matrix4d p_ = Eigen::Matrix4d::Zero();
   TimeNs t_ns_ = 0;
   bool have_steps_ = false;
   bool absolute_heading_seen_ = false;
