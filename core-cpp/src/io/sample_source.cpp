@@ -129,6 +129,79 @@ bool is_ole2(const std::string& head) { return head.size() >= 4 && std::memcmp(h
   throw IoError(path, 0, std::string("not a recording pdnav reads: ") + kExpected + "; found " + found);
 }
 
+/// A stream that yields `head` (already read from `rest`) and then the rest of `rest`. A pipe
+/// (or any file that is not a regular one) can be read once only, so format detection must
+/// hand the bytes it looked at to the reader instead of opening the path again.
+class PrefixedBuf : public std::streambuf {
+ public:
+  PrefixedBuf(std::string head, std::unique_ptr<std::istream> rest) : head_(std::move(head)), rest_(std::move(rest)) {
+    setg(head_.data(), head_.data(), head_.data() + head_.size());
+  }
+
+ protected:
+  int_type underflow() override {
+    if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
+    rest_->read(buf_.data(), static_cast<std::streamsize>(buf_.size()));
+    const std::streamsize n = rest_->gcount();
+    if (n <= 0) return traits_type::eof();
+    setg(buf_.data(), buf_.data(), buf_.data() + n);
+    return traits_type::to_int_type(*gptr());
+  }
+
+ private:
+  std::string head_;
+  std::unique_ptr<std::istream> rest_;
+  std::array<char, 1 << 16> buf_{};
+};
+
+class PrefixedStream : public std::istream {
+ public:
+  PrefixedStream(std::string head, std::unique_ptr<std::istream> rest)
+      : std::istream(nullptr), buf_(std::move(head), std::move(rest)) {
+    rdbuf(&buf_);
+  }
+
+ private:
+  PrefixedBuf buf_;
+};
+
+/// A recording that is not a regular file (a named pipe, a device): opened and read once.
+std::unique_ptr<SampleSource> open_stream_once(const std::string& path, Format fmt, SourceOptions opt) {
+  auto f = std::make_unique<std::ifstream>(path, std::ios::binary);
+  if (!*f) throw IoError(path, 0, std::string("cannot open: ") + std::strerror(errno));
+  std::string head(std::size_t{1} << 16, '\0');
+  f->read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(f->gcount()));
+  if (head.empty()) throw IoError(path, 0, "empty input (0 bytes)");
+  const std::string name = std::filesystem::path(path).filename().string();
+  const auto slurp = [&] {
+    std::string all = head;
+    all.append(std::istreambuf_iterator<char>(*f), std::istreambuf_iterator<char>());
+    return all;
+  };
+  if (detail::looks_like_zip(head)) return open_memory_source({{name + ".zip", slurp()}}, path, fmt, opt);
+  if (detail::looks_like_sensorlogger_json(head)) return open_memory_source({{name + ".json", slurp()}}, path, fmt, opt);
+  if (fmt == Format::kAuto) {
+    std::string found;
+    fmt = sniff_text(head, found);
+    if (fmt == Format::kAuto) not_recognised(path, found);
+  }
+  switch (fmt) {
+    case Format::kSession:
+    case Format::kGnssLogger:
+      return std::make_unique<LogSource>(LogReader(std::make_unique<PrefixedStream>(std::move(head), std::move(f)), path, opt.log),
+                                         fmt, opt.require_samples);
+    case Format::kGetSensorData:
+      return detail::open_getsensordata(std::make_unique<PrefixedStream>(std::move(head), std::move(f)), path, 0, opt);
+    case Format::kSensorLogger:
+    case Format::kPhyphox:
+      return open_memory_source({{name, slurp()}}, path, fmt, opt);
+    case Format::kAuto:
+      break;
+  }
+  not_recognised(path, "nothing");
+}
+
 std::unique_ptr<SampleSource> open_container(std::unique_ptr<detail::Container> c, Format fmt, SourceOptions opt) {
   std::string found;
   const Format sniffed = detail::sniff_container(*c, found);
@@ -235,6 +308,7 @@ std::unique_ptr<SampleSource> open_sample_source(const std::string& path, Format
   const auto st = fs::status(path, ec);
   if (ec || !fs::exists(st)) throw IoError(path, 0, "cannot open: no such file or folder");
   if (fs::is_directory(st)) return open_container(detail::open_folder(path), fmt, opt);
+  if (!fs::is_regular_file(st)) return open_stream_once(path, fmt, opt);
   const std::string head = read_head(path, 1u << 16);
   if (detail::looks_like_zip(head)) return open_container(detail::open_zip_file(path), fmt, opt);
   if (detail::looks_like_sensorlogger_json(head) && (fmt == Format::kAuto || fmt == Format::kSensorLogger))
