@@ -183,20 +183,28 @@ bool FusionFilter::agree(const std::vector<Held>& h, Eigen::Vector2d* mean_nu) c
   return chi2 <= chi2_quantile(2 * (static_cast<int>(h.size()) - 1), opt_.agreement_p);
 }
 
-PositionUpdateResult FusionFilter::update_position(TimeNs t_ns, const Eigen::Vector2d& z_en_m, const Eigen::Matrix2d& r_in,
-                                                   bool use_gate_policy, double floor_fraction) {
-  PositionUpdateResult res;
-  floor_fraction_ = floor_fraction;
+bool FusionFilter::carry_to_last_step(TimeNs t_ns, const Eigen::Vector2d& z_en_m, const Eigen::Matrix2d& r_in,
+                                      Eigen::Vector2d* z, Eigen::Matrix2d* r, PositionUpdateResult* res) {
   if (!initialized_ || !z_en_m.allFinite() || !r_in.allFinite() || !(r_in.determinant() > 0.0)) {
-    res.reason = "invalid measurement";
-    return res;
+    res->reason = "invalid measurement";
+    return false;
   }
   advance_to(t_ns);
   Eigen::Vector2d d_after;
   double var_after = 0.0;
   after(t_ns, &d_after, &var_after);
-  const Eigen::Vector2d z = z_en_m + d_after;  // the measurement carried to the last step
-  const Eigen::Matrix2d r = r_in + var_after * Eigen::Matrix2d::Identity();
+  *z = z_en_m + d_after;  // the measurement carried to the last step
+  *r = r_in + var_after * Eigen::Matrix2d::Identity();
+  return true;
+}
+
+PositionUpdateResult FusionFilter::update_position(TimeNs t_ns, const Eigen::Vector2d& z_en_m, const Eigen::Matrix2d& r_in,
+                                                   bool use_gate_policy, double floor_fraction) {
+  PositionUpdateResult res;
+  floor_fraction_ = floor_fraction;
+  Eigen::Vector2d z;
+  Eigen::Matrix2d r;
+  if (!carry_to_last_step(t_ns, z_en_m, r_in, &z, &r, &res)) return res;
   const Eigen::Vector2d nu = z - x_.head<2>();
   const Eigen::Matrix2d s = p_.topLeftCorner<2, 2>() + r;
   res.nis = nu.dot(s.inverse() * nu);
@@ -263,16 +271,9 @@ PositionUpdateResult FusionFilter::update_position(TimeNs t_ns, const Eigen::Vec
 PositionUpdateResult FusionFilter::update_position_ci(TimeNs t_ns, const Eigen::Vector2d& z_en_m,
                                                       const Eigen::Matrix2d& r_in) {
   PositionUpdateResult res;
-  if (!initialized_ || !z_en_m.allFinite() || !r_in.allFinite() || !(r_in.determinant() > 0.0)) {
-    res.reason = "invalid measurement";
-    return res;
-  }
-  advance_to(t_ns);
-  Eigen::Vector2d d_after;
-  double var_after = 0.0;
-  after(t_ns, &d_after, &var_after);
-  const Eigen::Vector2d z = z_en_m + d_after;
-  const Eigen::Matrix2d r = r_in + var_after * Eigen::Matrix2d::Identity();
+  Eigen::Vector2d z;
+  Eigen::Matrix2d r;
+  if (!carry_to_last_step(t_ns, z_en_m, r_in, &z, &r, &res)) return res;
   const Eigen::Vector2d nu = z - x_.head<2>();
   const Eigen::Matrix2d pp = p_.topLeftCorner<2, 2>();
   res.nis = nu.dot((pp + r).inverse() * nu);

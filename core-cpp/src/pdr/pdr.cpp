@@ -136,33 +136,18 @@ void Pdr::track_handling() {
 }
 
 void Pdr::feed(const UncalAccelSample& s) {
-  if (!uncal_allowed(s.t_ns, last_cal_accel_ns_, first_uncal_accel_ns_)) return;
-  ++sensors_.uncal_accel;
-  --sensors_.accel;  // counted once, as uncalibrated
-  AccelSample a{s.t_ns, s.utc_ms, s.acc_mps2 - s.bias_mps2};
-  const TimeNs keep = last_cal_accel_ns_;
-  feed(a);
-  last_cal_accel_ns_ = keep;
+  feed_uncal(AccelSample{s.t_ns, s.utc_ms, s.acc_mps2 - s.bias_mps2}, sensors_.uncal_accel, sensors_.accel,
+             last_cal_accel_ns_, first_uncal_accel_ns_);
 }
 
 void Pdr::feed(const UncalGyroSample& s) {
-  if (!uncal_allowed(s.t_ns, last_cal_gyro_ns_, first_uncal_gyro_ns_)) return;
-  ++sensors_.uncal_gyro;
-  --sensors_.gyro;
-  GyroSample g{s.t_ns, s.utc_ms, s.rate_radps - s.drift_radps};
-  const TimeNs keep = last_cal_gyro_ns_;
-  feed(g);
-  last_cal_gyro_ns_ = keep;
+  feed_uncal(GyroSample{s.t_ns, s.utc_ms, s.rate_radps - s.drift_radps}, sensors_.uncal_gyro, sensors_.gyro,
+             last_cal_gyro_ns_, first_uncal_gyro_ns_);
 }
 
 void Pdr::feed(const UncalMagSample& s) {
-  if (!uncal_allowed(s.t_ns, last_cal_mag_ns_, first_uncal_mag_ns_)) return;
-  ++sensors_.uncal_mag;
-  --sensors_.mag;
-  MagSample m{s.t_ns, s.utc_ms, s.field_ut - s.bias_ut};
-  const TimeNs keep = last_cal_mag_ns_;
-  feed(m);
-  last_cal_mag_ns_ = keep;
+  feed_uncal(MagSample{s.t_ns, s.utc_ms, s.field_ut - s.bias_ut}, sensors_.uncal_mag, sensors_.mag, last_cal_mag_ns_,
+             first_uncal_mag_ns_);
 }
 
 void Pdr::feed(const AccelSample& s) {

@@ -127,6 +127,10 @@ class FusionFilter {
   struct Held { TimeNs t_ns; Eigen::Vector2d z, nu; Eigen::Matrix2d r; };
   /// Steps after t_ns: their displacement and variance.
   void after(TimeNs t_ns, Eigen::Vector2d* d, double* var) const;
+  /// Checks a position measurement, advances to t_ns and carries it (and its variance) to the
+  /// last step; false with res->reason set when it is invalid.
+  bool carry_to_last_step(TimeNs t_ns, const Eigen::Vector2d& z_en_m, const Eigen::Matrix2d& r_in, Eigen::Vector2d* z,
+                          Eigen::Matrix2d* r, PositionUpdateResult* res);
   void apply_position(const Eigen::Vector2d& z, const Eigen::Matrix2d& r);
   bool agree(const std::vector<Held>& h, Eigen::Vector2d* mean_nu) const;
   void symmetrize();

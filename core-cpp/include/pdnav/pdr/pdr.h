@@ -244,6 +244,18 @@ class Pdr {
     const TimeNs since = last_calibrated_ns < 0 ? t_ns - first_uncal_ns : t_ns - last_calibrated_ns;
     return ns_to_s(since) > opt_.uncal_fallback_s;
   }
+  /// An allowed uncalibrated sample, bias removed, goes through its calibrated twin's feed,
+  /// counted once (as uncalibrated) and without counting as a calibrated reading.
+  template <class Calibrated>
+  void feed_uncal(const Calibrated& bias_removed, std::int64_t& uncal_count, std::int64_t& cal_count,
+                  TimeNs& last_cal_ns, TimeNs& first_uncal_ns) {
+    if (!uncal_allowed(bias_removed.t_ns, last_cal_ns, first_uncal_ns)) return;
+    ++uncal_count;
+    --cal_count;
+    const TimeNs keep = last_cal_ns;
+    feed(bias_removed);
+    last_cal_ns = keep;
+  }
 
   PdrOptions opt_;
   StepDetector detector_;
