@@ -385,6 +385,7 @@ TerrainOptions TerrainOptions::srtm_tuned() {
   o.baro_scale_sigma = 0.017;
   o.stride_grade_sigma = 0.10;
   o.stride_grade_corr_m = 300.0;
+  o.stride_walk_grade_sigma = 0.15;  // issue 28: route-mean grade, a walk constant (docs/terrain.md)
   return o;
 }
 
@@ -486,6 +487,10 @@ struct TerrainEngine::Impl {
     const auto s = static_cast<float>(start_sigma(sigma_m));
     const auto hs = static_cast<float>(opt.heading_bias_sigma_rad);
     const auto bs = static_cast<float>(opt.baro_bias_sigma_m);
+    // Per-walk step-scale draw: the walker's stride vs the model and, with the grade stride
+    // term, the route's mean-grade shortening (independent, so in quadrature).
+    const double walk_grade = opt.stride_grade_sigma > 0.0 ? opt.stride_walk_grade_sigma : 0.0;
+    const auto ss = static_cast<float>(std::hypot(opt.step_scale_sigma, walk_grade));
     const DemSample ground = dem->at_local(en.x(), en.y());
     const auto h_start = static_cast<float>(ground.valid() ? ground.elevation_m : kNaN);
     for (std::size_t i = 0; i < count; ++i) {
@@ -493,7 +498,7 @@ struct TerrainEngine::Impl {
       p.n[i] = static_cast<float>(en.y()) + s * normal();
       p.bh[i] = hs * normal();
       p.bb[i] = opt.rao_blackwell_baro_bias ? 0.0f : bs * normal();
-      p.sc[i] = static_cast<float>(opt.step_scale_sigma) * normal();
+      p.sc[i] = ss * normal();
       p.h0[i] = dem->elevation_or_nan(p.e[i], p.n[i]);
       // The barometer reads DEM(declared start) at the start; a particle that starts at x_i
       // explains that reading only with the offset DEM(declared) - DEM(x_i) (docs/terrain.md).

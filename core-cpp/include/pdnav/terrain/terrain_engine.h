@@ -69,6 +69,13 @@ struct TerrainOptions {
   /// with this sigma and correlation length. Needs step_scale_sigma > 0 and the RB bias. 0 = off.
   double stride_grade_sigma = 0.0;
   double stride_grade_corr_m = 300.0;
+  /// Beyond the paper (issue 28): the part of the grade effect that is constant over a walk. A
+  /// route's mean steepness shortens the stride for the whole walk (gait on slopes: roughly
+  /// 10 % shorter at a 12 % grade, Kawamura et al. 1991; mountain routes average 20-30 % grade),
+  /// which a level-ground step model (APT) does not know and the 300 m FOGM above cannot hold
+  /// for a whole walk. Added in quadrature to step_scale_sigma for the per-walk scale draw, as a
+  /// zero-mean prior (the filter is not told the direction). Used only with stride_grade_sigma.
+  double stride_walk_grade_sigma = 0.0;
   /// Beyond the paper: roughening after resampling (Gordon et al. 1993), K; 0 = off.
   double roughening_k = 0.0;
   // --- residual monitoring (the paper mentions it without detail; docs/terrain.md) ---
@@ -124,7 +131,8 @@ struct TerrainOptions {
   /// walked, a step-scale state (sigma 3 %), roughening K = 0.2, the segment-mean elevation and
   /// the Rao-Blackwellised baro bias; since issue 17 also the correlated DEM-error term (5 m,
   /// 150 m), the baro scale term (1.7 %) and the grade-varying stride (10 %, 300 m), for the
-  /// simulator's world error models. The eval-terrain default.
+  /// simulator's world error models; since issue 28 the per-walk grade stride term (15 %).
+  /// The eval-terrain default.
   static TerrainOptions srtm_tuned();
   /// "paper", "srtm" or "srtm-tuned"; throws std::invalid_argument.
   static TerrainOptions preset(const std::string& name);
