@@ -70,10 +70,10 @@ struct TerrainOptions {
   double stride_grade_sigma = 0.0;
   double stride_grade_corr_m = 300.0;
   /// Beyond the paper (issue 28): the part of the grade effect that is constant over a walk. A
-  /// route's mean steepness shortens the stride for the whole walk (gait on slopes: roughly
-  /// 10 % shorter at a 12 % grade, Kawamura et al. 1991; mountain routes average 20-30 % grade),
-  /// which a level-ground step model (APT) does not know and the 300 m FOGM above cannot hold
-  /// for a whole walk. Added in quadrature to step_scale_sigma for the per-walk scale draw, as a
+  /// route's mean steepness shortens the stride for the whole walk (the gait data behind
+  /// stride_grade_sigma: several % per 10 % grade; mountain routes average 20-30 % grade, so
+  /// 10-20 %: 15 %), which a level-ground step model (APT) does not know and the 300 m FOGM
+  /// above cannot hold for a whole walk. Added in quadrature to step_scale_sigma for the per-walk scale draw, as a
   /// zero-mean prior (the filter is not told the direction). Used only with stride_grade_sigma.
   double stride_walk_grade_sigma = 0.0;
   /// Beyond the paper: roughening after resampling (Gordon et al. 1993), K; 0 = off.
