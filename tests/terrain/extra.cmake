@@ -36,6 +36,15 @@ add_test(NAME terrain.eval_bar_app_path
 set_tests_properties(terrain.eval_bar_app_path PROPERTIES FIXTURES_REQUIRED terrain_tile_andorra
                      LABELS "terrain;cli" TIMEOUT 300)
 
+# Issue 28: over 12 whole simulated walks without GNSS (app path: replay dr / terrain / auto) the
+# pooled fused estimate is inside its 1-sigma ellipse 30-50 % of the time and the terrain estimate
+# inside its 68 % region 60-80 % (tools/whole-walks --check).
+add_test(NAME terrain.whole_walks_coverage
+  COMMAND /usr/bin/python3 "${PROJECT_SOURCE_DIR}/tools/whole-walks" --dem "${PDNAV_TERRAIN_TILE}"
+          --pdnav "$<TARGET_FILE:pdnav>" --seeds 1-12 --out "${PDNAV_TERRAIN_SCRATCH}/whole-walks" --check)
+set_tests_properties(terrain.whole_walks_coverage PROPERTIES FIXTURES_REQUIRED terrain_tile_andorra
+                     LABELS "terrain;cli" TIMEOUT 300)
+
 add_test(NAME terrain.simulate_log
   COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/terrain/check_simulate.py"
           "$<TARGET_FILE:pdnav>" "${PDNAV_TERRAIN_TILE}" "${PDNAV_TERRAIN_SCRATCH}")
