@@ -115,6 +115,7 @@ class NaivePdr {
         pos_en_ += kStepM * Eigen::Vector2d(std::sin(yaw_rad_), std::cos(yaw_rad_));
         last_step_ns_ = s.t_ns;
         ++steps_;
+        step_times_.push_back(s.t_ns);
       }
     }
     have_ = true;
@@ -128,9 +129,11 @@ class NaivePdr {
   std::int64_t steps_since_start() const { return steps_ - steps_at_start_; }
   const Eigen::Vector2d& pos_en() const { return pos_en_; }
   std::int64_t steps() const { return steps_; }
+  const std::vector<TimeNs>& step_times() const { return step_times_; }
 
  private:
   std::int64_t steps_ = 0, steps_at_start_ = 0;
+  std::vector<TimeNs> step_times_;
   static constexpr double kCutHz = 3.0, kPeakAboveG = 1.0, kMinGapS = 0.3, kStepM = 0.70;
   bool have_ = false, have_yaw_ = false;
   TimeNs last_ns_ = 0, last_step_ns_ = 0;
@@ -149,6 +152,7 @@ struct WalkResult {
   std::map<std::string, std::string> meta;  // the log's Meta lines (latest value per key)
   std::vector<double> still_errors_m;       // "still": the estimate stays at the start
   std::int64_t naive_steps = 0;
+  std::int64_t steps_in_truth_span = -1, naive_steps_in_truth_span = -1;  // -1: no Meta TruthStepsFrom/ToNanos
   double truth_path_m = kNaN, final_m = kNaN, naive_final_m = kNaN, still_final_m = kNaN;
   double rms_pct = kNaN, naive_rms_pct = kNaN, still_rms_pct = kNaN;  // RMS error / truth path, % (aligned)
   double align_deg = kNaN, naive_align_deg = kNaN;  // --align-start-s: rotation applied to the track
@@ -241,6 +245,7 @@ class Runner {
   void feed(const Sample& s) {
     if (nav_) {
       nav_->feed(s);
+      for (const fusion::StepEstimate& st : nav_->take_steps()) step_times_.push_back(st.estimate.t_ns);
       return;
     }
     std::visit(
@@ -256,6 +261,7 @@ class Runner {
         s);
     for (const PdrStep& st : pdr_->take_steps()) {
       ++steps_;
+      step_times_.push_back(st.t_ns);
       if (started_) {
         const Eigen::Vector2d d = st.length_m * Eigen::Vector2d(std::sin(st.heading_rad), std::cos(st.heading_rad));
         en_ += d;
@@ -290,6 +296,8 @@ class Runner {
   }
   double path_m() const { return path_m_; }
   std::int64_t steps() const { return nav_ ? nav_->output(0).steps : steps_; }
+  /// Each emitted step's own time (the dead-reckoning estimate's time after it).
+  const std::vector<TimeNs>& step_times() const { return step_times_; }
   /// Magnetometer readings tested for a quasi-static field and found so (direct Pdr only).
   std::pair<std::int64_t, std::int64_t> quasi_static_field() const {
     if (!pdr_) return {0, 0};
@@ -308,6 +316,7 @@ class Runner {
   Eigen::Vector2d en_ = Eigen::Vector2d::Zero(), last_en_ = Eigen::Vector2d::Zero();
   double path_m_ = 0;
   std::int64_t steps_ = 0;
+  std::vector<TimeNs> step_times_;
 };
 
 /// Heading error of an estimated displacement against the surveyed segment, degrees, + =
@@ -483,6 +492,24 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   r.naive_ratio = truth_len > 0 ? naive_path_m / truth_len : kNaN;
   r.steps = run.steps();
   r.naive_steps = naive.steps_since_start();
+  // the span a step truth covers (tools/tyrex2log: the capture less half a window at each end)
+  const auto span_meta = [&r, &path](const char* key) -> std::optional<TimeNs> {
+    const auto it = r.meta.find(key);
+    if (it == r.meta.end() || it->second.empty()) return std::nullopt;
+    try {
+      return static_cast<TimeNs>(std::stoll(it->second));
+    } catch (const std::exception&) {
+      throw std::runtime_error(path + ": Meta " + key + " is not an integer: " + it->second);
+    }
+  };
+  const auto from = span_meta("TruthStepsFromNanos"), to = span_meta("TruthStepsToNanos");
+  if (from && to) {
+    const auto in_span = [&](const std::vector<TimeNs>& ts) {
+      return static_cast<std::int64_t>(std::count_if(ts.begin(), ts.end(), [&](TimeNs t) { return t >= *from && t <= *to; }));
+    };
+    r.steps_in_truth_span = in_span(run.step_times());
+    r.naive_steps_in_truth_span = in_span(naive.step_times());
+  }
   std::tie(r.qsf_tested, r.qsf_static) = run.quasi_static_field();
   r.truth_path_m = truth_len;
   r.final_m = r.errors_m.back();
@@ -528,6 +555,10 @@ nlohmann::json walk_json(const WalkResult& r, const EvalPdrArgs& a) {
   j["truth_path_m"] = num(r.truth_path_m);
   j["steps"] = r.steps;
   j["naive_steps"] = r.naive_steps;
+  if (r.steps_in_truth_span >= 0) {
+    j["steps_in_truth_span"] = r.steps_in_truth_span;
+    j["naive_steps_in_truth_span"] = r.naive_steps_in_truth_span;
+  }
   j["mean_m"] = num(r.mean_m);
   j["final_m"] = num(r.final_m);
   j["naive_mean_m"] = num(r.naive_mean_m);

@@ -51,7 +51,13 @@ struct FileResult {
   std::vector<PdrTurn> turns;
   std::vector<PdrStep> steps;
   std::string heading_frame;  // how the headings are referenced (true north via WMM, or magnetic)
+  double max_delay_s = 0.0, max_delay_at_s = 0.0;  // longest step-to-emission latency, that step's time
 };
+
+void note_delay(FileResult& r, const pdr::PdrCounters& c, TimeNs t0_ns) {
+  r.max_delay_s = c.max_step_delay_s;
+  r.max_delay_at_s = c.max_step_delay_s > 0.0 ? ns_to_s(c.max_step_delay_at_ns - t0_ns) : 0.0;
+}
 
 /// Issue 19.4: the log's Meta start (StartLatitudeDegrees/StartLongitudeDegrees) and its first
 /// UTC time give the WMM declination; without a start the headings stay magnetic, and say so.
@@ -157,6 +163,7 @@ FileResult run_log(const std::string& path, const pdr::PdrOptions& options) {
   r.detected = engine.step_count();
   r.duration_s = first ? 0.0 : ns_to_s(t1 - t0);
   r.counters = engine.counters().accel;
+  note_delay(r, engine.counters(), t0);
   r.android_events = engine.counters().step_detector.accepted;
   r.consistency = engine.consistency();
   if (reader.stats().skipped_total() > 0) {
@@ -182,6 +189,7 @@ FileResult run_oxford(const std::string& path, const pdr::PdrOptions& options) {
   for (auto& st : engine.take_steps()) r.steps.push_back(st);
   r.detected = engine.step_count();
   r.counters = engine.counters().accel;
+  note_delay(r, engine.counters(), rec.samples.empty() ? 0 : rec.samples.front().t_ns);
   if (rec.samples.size() >= 2) r.duration_s = ns_to_s(rec.samples.back().t_ns - rec.samples.front().t_ns);
   return r;
 }
@@ -204,6 +212,7 @@ void print_file(const FileResult& r, bool list) {
   if (r.truth >= 0) std::printf(", truth %lld", static_cast<long long>(r.truth));
   std::printf("\n");
   if (!r.heading_frame.empty()) std::printf("  %s\n", r.heading_frame.c_str());
+  if (r.detected > 0) std::printf("  step latency: max %.2f s (the step at %.1f s)\n", r.max_delay_s, r.max_delay_at_s);
   const auto& c = r.counters;
   if (c.skipped() > 0 || c.gaps > 0) {
     std::printf("  accel samples skipped: %lld non-finite, %lld duplicate time, %lld backwards time; %lld gaps (detector reset)\n",

@@ -161,6 +161,7 @@ void Pdr::feed(const AccelSample& s) {
   }
   have_accel_ = true;
   last_cal_accel_ns_ = s.t_ns;
+  latest_ns_ = std::max(latest_ns_, s.t_ns);  // "now" for the steps the waits below release
   tracker_.feed(s);
   classifier_.feed(s);
   track_handling();
@@ -269,11 +270,20 @@ void Pdr::settle_handling_wait(TimeNs now_ns, bool force) {
 }
 
 void Pdr::deliver_after_handling(HeldStep h, TimeNs now_ns) {
-  if (vehicle_gated()) {
+  if (vehicle_gated() || !vehicle_wait_.empty()) {  // in order behind the steps already waiting
     vehicle_wait_.push_back(h);
+    settle_vehicle_wait(now_ns, false);
     return;
   }
   deliver_walking(h, now_ns);
+}
+
+bool Pdr::vehicle_decision_possible(TimeNs step_ns, TimeNs now_ns) const {
+  // The score rises at most one second per second of evidence: a step waits only while the
+  // vehicle could still be declared before it is vehicle_max_wait_s old.
+  const MotionClassifierOptions& m = opt_.motion;
+  const double left_s = opt_.vehicle_max_wait_s - ns_to_s(now_ns - step_ns);
+  return classifier_.vehicle_suspect() && left_s > 0.0 && classifier_.vehicle_score_s() + left_s >= m.vehicle_enter_s;
 }
 
 void Pdr::settle_vehicle_wait(TimeNs now_ns, bool force) {
@@ -287,10 +297,11 @@ void Pdr::settle_vehicle_wait(TimeNs now_ns, bool force) {
     }
     return;
   }
-  if (classifier_.vehicle_suspect() && !force) return;
-  std::deque<HeldStep> waiting;
-  waiting.swap(vehicle_wait_);
-  for (auto& h : waiting) {
+  // oldest first: a younger step can wait whenever an older one can
+  while (!vehicle_wait_.empty()) {
+    const HeldStep h = vehicle_wait_.front();
+    if (!force && vehicle_decision_possible(h.candidate.t_ns, now_ns)) return;
+    vehicle_wait_.pop_front();
     if (classifier_.vehicle_at(h.candidate.t_ns)) {
       ++counters_.steps_discarded_by_vehicle;
     } else if (h.android) {
@@ -450,8 +461,12 @@ void Pdr::feed(const StepDetectorSample& s) {
     event.interval_s = 0.0;  // unknown: the length model's cadence fallback
     HeldStep h = hold(event);
     h.android = true;
-    if (vehicle_gated()) vehicle_wait_.push_back(h);
-    else emit_step(h);
+    if (vehicle_gated() || !vehicle_wait_.empty()) {
+      vehicle_wait_.push_back(h);
+      settle_vehicle_wait(s.t_ns, false);
+    } else {
+      emit_step(h);
+    }
   }
   trim_consistency(s.t_ns);
 }
@@ -476,6 +491,11 @@ double Pdr::heading_sigma_rad() const {
 void Pdr::emit_step(const HeldStep& h) {
   PdrStep st;
   st.t_ns = h.candidate.t_ns;
+  const double delay_s = ns_to_s(latest_ns_ - st.t_ns);
+  if (delay_s > counters_.max_step_delay_s) {
+    counters_.max_step_delay_s = delay_s;
+    counters_.max_step_delay_at_ns = st.t_ns;
+  }
   const double interval_s = h.candidate.interval_s;
   st.length_m = opt_.length.length_m(h.candidate.swing_mps2, interval_s > 0.0 ? 1.0 / interval_s : kNaN);
   st.length_sigma_m = opt_.length.sigma_m(st.length_m);

@@ -57,6 +57,12 @@ struct PdrOptions {
   bool gate_handling = true;     // no steps while the phone is handled or waved
   bool gate_vehicle = true;      // no steps while riding (motion.vehicle must be on); steps
                                  // wait while vehicle evidence accumulates (docs/pdr.md)
+  /// Bounded latency of that wait (issue 27): a step waits for the vehicle decision only while
+  /// the decision could still come before the step is this old (the score rises at most 1 s
+  /// per s, so with score S a step of age a waits while S + (max - a) >= vehicle_enter_s).
+  /// One vehicle window (the evidence's own span, MotionClassifierOptions::vehicle_window_s);
+  /// before, a step waited while the score was > 0: up to 18.5 s on the ETH walk.
+  double vehicle_max_wait_s = 4.0;
   StepSource source = StepSource::kAccelerometer;
   double android_timeout_s = 3.0;
   /// Consistency check: the two step sources agree when their counts differ by at most this
@@ -88,6 +94,11 @@ struct PdrCounters {
   std::int64_t mag_readings_disturbed = 0;     // ... and that failed them (down-weighted)
   std::int64_t mag_readings_qsf_tested = 0;    // magnetometer readings tested for a quasi-static field
   std::int64_t mag_readings_quasi_static = 0;  // ... and found quasi-static (full weight)
+  /// Latency of the emitted steps: the longest time from a step to its emission (newest
+  /// sample time then minus the step's own time; the bout gate, handling, vehicle and
+  /// walking-direction waits all add to it) and the time of that step.
+  double max_step_delay_s = 0.0;
+  TimeNs max_step_delay_at_ns = 0;
   std::int64_t total_skipped() const {
     return accel.skipped() + gyro.skipped() + mag.skipped() + rotation_vector.skipped() + step_detector.skipped();
   }
@@ -212,6 +223,9 @@ class Pdr {
   /// Steps held while vehicle evidence accumulates: dropped inside a vehicle span, delivered
   /// once the evidence is gone (or at the end of the input).
   void settle_vehicle_wait(TimeNs now_ns, bool force);
+  /// The vehicle could still be declared before a step taken at step_ns is
+  /// PdrOptions::vehicle_max_wait_s old (the score rises at most 1 s per s).
+  bool vehicle_decision_possible(TimeNs step_ns, TimeNs now_ns) const;
   /// Steps held one classifier window while handling is suspected: dropped if a handling span
   /// covers them by then, else delivered.
   void settle_handling_wait(TimeNs now_ns, bool force);
