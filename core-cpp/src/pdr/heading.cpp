@@ -1,6 +1,7 @@
 // Rotation-vector / compass heading and APT's gyro re-orientation (Zhu/Li/Chen 2013, Sec. V-B).
 #include "pdnav/pdr/heading.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -77,7 +78,12 @@ void GyroTurnTracker::feed(const AccelSample& s) {
   if (c == SampleCheck::kGap) {
     acc_window_.clear();
     acc_sum_.setZero();
+    tilt_ok_ = false;
   }
+  const double dt_acc = have_acc_last_ ? ns_to_s(s.t_ns - acc_last_ns_) : 0.0;
+  const double a_norm = s.acc_mps2.norm();
+  if (tilt_ok_ && dt_acc > 0.0 && a_norm > 1e-6)  // pulled toward the specific force (Mahony)
+    tilt_up_ = (tilt_up_ + std::min(1.0, dt_acc / opt_.tilt_tau_s) * (s.acc_mps2 / a_norm - tilt_up_)).normalized();
   have_acc_last_ = true;
   acc_last_ns_ = s.t_ns;
   acc_window_.emplace_back(s.t_ns, s.acc_mps2);
@@ -97,6 +103,10 @@ void GyroTurnTracker::feed(const AccelSample& s) {
       have_gravity_ = true;
     }
   }
+  if (!tilt_ok_ && have_gravity_ && window_full && opt_.tilt_tau_s > 0.0) {  // starts from the mean
+    tilt_up_ = up_;
+    tilt_ok_ = true;
+  }
 }
 
 void GyroTurnTracker::feed(const GyroSample& s) {
@@ -108,11 +118,21 @@ void GyroTurnTracker::feed(const GyroSample& s) {
     // Heading across the gap is unknown: restart the windows (no turn spans a gap).
     history_.clear();
     state_ = State::kStraight;
+    tilt_ok_ = false;
   }
   if (integrate) {
-    // Trapezoidal angular displacement, projected on the vertical (APT Sec. V-B).
+    // Trapezoidal angular displacement, projected on the vertical (APT Sec. V-B): about the
+    // tilt filter's instantaneous gravity, which the same rotation carries along (a world-fixed
+    // vector moves as u x w in phone axes), else about the held mean
     const double dt = ns_to_s(s.t_ns - gyro_last_ns_);
-    yaw_rad_ += 0.5 * (s.rate_radps + gyro_last_).dot(up_) * dt;
+    const Eigen::Vector3d w = 0.5 * (s.rate_radps + gyro_last_);
+    if (tilt_ok_) {
+      const Eigen::Vector3d before = tilt_up_;
+      tilt_up_ = (tilt_up_ + tilt_up_.cross(w) * dt).normalized();
+      yaw_rad_ += w.dot(0.5 * (before + tilt_up_)) * dt;
+    } else {
+      yaw_rad_ += w.dot(up_) * dt;
+    }
   }
   have_gyro_last_ = true;
   gyro_last_ns_ = s.t_ns;

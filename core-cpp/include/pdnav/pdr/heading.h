@@ -40,6 +40,12 @@ struct TurnOptions {
   double straight_threshold_rad = 15 * kDegToRad;  // |displacement| in a window below this = straight
   double report_threshold_rad = 30 * kDegToRad;  // APT: a turn is reported past 30 degrees
   double gap_reset_s = 0.5;                      // gyro/accel gap that resets the integration
+  // Instantaneous gravity for the yaw integral and the compass: a gyro-propagated tilt pulled
+  // toward the specific force with this time constant (Mahony, Hamel, Pflimlin, IEEE TAC 2008;
+  // as the placement's tilt filter). A phone in a pocket or a swinging hand tilts by tens of
+  // degrees every stride: about APT's held 1 s mean the integral mixes that swing into the yaw
+  // and the compass, so their sum (the heading offset) never holds still. 0 = APT's 1 s mean.
+  double tilt_tau_s = 1.0;
 };
 
 struct HeadingOptions {
@@ -79,8 +85,9 @@ class GyroTurnTracker {
   /// Integrated yaw about the vertical since start (rad, left positive); valid once gravity is known.
   double yaw_rad() const { return yaw_rad_; }
   bool has_gravity() const { return have_gravity_; }
-  /// Unit "up" vector in phone axes (mean specific force while walking straight).
-  const Eigen::Vector3d& up_phone() const { return up_; }
+  /// Unit "up" vector in phone axes: the tilt filter's instantaneous gravity (tilt_tau_s > 0),
+  /// else the mean specific force while walking straight.
+  const Eigen::Vector3d& up_phone() const { return tilt_ok_ ? tilt_up_ : up_; }
   bool straight() const { return state_ == State::kStraight; }
   std::vector<PdrTurn> take_turns();
   const SampleCounters& gyro_counters() const { return gyro_counters_; }
@@ -106,6 +113,8 @@ class GyroTurnTracker {
   TimeNs acc_last_ns_ = 0;
   Eigen::Vector3d up_ = Eigen::Vector3d::UnitZ();
   bool have_gravity_ = false;
+  Eigen::Vector3d tilt_up_ = Eigen::Vector3d::UnitZ();  // tilt filter (tilt_tau_s > 0)
+  bool tilt_ok_ = false;
   // gyro integration
   bool have_gyro_last_ = false;
   TimeNs gyro_last_ns_ = 0;
