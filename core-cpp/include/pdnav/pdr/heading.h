@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "pdnav/geo/events.h"
 #include "pdnav/geo/samples.h"
@@ -84,6 +85,14 @@ class GyroTurnTracker {
 
   /// Integrated yaw about the vertical since start (rad, left positive); valid once gravity is known.
   double yaw_rad() const { return yaw_rad_; }
+  /// The phone axis whose heading axis_yaw_rad() follows (the heading filter's reference axis).
+  void set_yaw_axis(const Eigen::Vector3d& axis_phone);
+  /// Yaw (rad, left positive, continuous) of the yaw axis' horizontal projection in the
+  /// gyro-propagated attitude (tilt_tau_s > 0), else yaw_rad(). Unlike the integral of the
+  /// vertical rate, it has no coning drift: a phone swung about two axes at once (a running
+  /// pocket) accumulates the area its swing encloses in that integral, several deg/s. Held
+  /// while the axis is within ~12 deg of the vertical.
+  double axis_yaw_rad() const { return tilt_ok_ ? axis_yaw_rad_ : yaw_rad_; }
   bool has_gravity() const { return have_gravity_; }
   /// Unit "up" vector in phone axes: the tilt filter's instantaneous gravity (tilt_tau_s > 0),
   /// else the mean specific force while walking straight.
@@ -113,8 +122,14 @@ class GyroTurnTracker {
   TimeNs acc_last_ns_ = 0;
   Eigen::Vector3d up_ = Eigen::Vector3d::UnitZ();
   bool have_gravity_ = false;
-  Eigen::Vector3d tilt_up_ = Eigen::Vector3d::UnitZ();  // tilt filter (tilt_tau_s > 0)
+  Eigen::Vector3d tilt_up_ = Eigen::Vector3d::UnitZ();  // tilt filter (tilt_tau_s > 0): up in phone axes
   bool tilt_ok_ = false;
+  Eigen::Quaterniond attitude_ = Eigen::Quaterniond::Identity();  // phone -> level gyro frame
+  Eigen::Vector3d yaw_axis_ = Eigen::Vector3d::UnitY();
+  double axis_yaw_rad_ = 0.0;   // continuous
+  double axis_yaw_wrapped_ = 0.0;
+  bool axis_yaw_init_ = false;
+  void update_axis_yaw();
   // gyro integration
   bool have_gyro_last_ = false;
   TimeNs gyro_last_ns_ = 0;
