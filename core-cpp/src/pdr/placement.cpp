@@ -192,7 +192,11 @@ void PlacementEstimator::update_forward() {
     // body, and the unlevelled correlation's direction scatters 32 deg around it on ILC)
     const Eigen::Vector3d prior_axis = -Eigen::Vector3d::UnitZ();
     const Eigen::Vector3d ph = prior_axis - prior_axis.dot(up_) * up_;
-    if (trusted && walking_s_ >= opt_.prior_check_s && d.norm() > 1e-9 && ph.norm() > 0.2) {
+    // A dominant horizontal rotation axis (a limb carry: trouser pocket, swinging hand) is direct
+    // evidence of the walking direction and replaces the prior too
+    if (trusted && walking_s_ >= opt_.prior_check_s && rotation_axis_forward()) {
+      prior_rejected_ = true;
+    } else if (trusted && walking_s_ >= opt_.prior_check_s && d.norm() > 1e-9 && ph.norm() > 0.2) {
       const double cos_line = std::abs(d.normalized().dot(ph.normalized()));
       prior_rejected_ = cos_line < std::cos(opt_.prior_max_angle_rad);
     }
