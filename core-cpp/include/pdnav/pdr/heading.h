@@ -75,7 +75,9 @@ std::optional<double> compass_heading_rad(const Eigen::Vector3d& field_phone, co
                                           const Eigen::Vector3d& forward_phone, double min_horizontal = 0.25);
 
 /// APT's gyro re-orientation: integrates the gyro about the estimated gravity (yaw, positive =
-/// counter-clockwise seen from above = left) and reports turns.
+/// counter-clockwise seen from above = left) and reports turns. With tilt_tau_s > 0 it also
+/// keeps a gyro-propagated, accelerometer-levelled attitude: the instantaneous gravity and the
+/// yaw of one phone axis (axis_yaw_rad(), the heading fusion's reference axis).
 class GyroTurnTracker {
  public:
   explicit GyroTurnTracker(const TurnOptions& options = {});

@@ -23,6 +23,8 @@
 // placement.cpp), the 2 s mean is used. The upright prior axis (-Z) stands only while the
 // motion's direction is within prior_max_angle_rad of its line (a phone at the ear or in a
 // trouser pocket is upright too, but walks along +-X or obliquely).
+// Limb carries (pocket, swinging hand): the walking direction is square to the dominant
+// horizontal axis of the gait rotation (rotation_axis_max_ratio), signed by the correlation.
 // One constant offset per placement bout; a bout ends when the gravity direction in phone
 // axes moves by more than change_angle_rad for change_hold_s (the phone was moved).
 #pragma once
