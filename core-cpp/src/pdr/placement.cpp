@@ -231,7 +231,8 @@ std::optional<Eigen::Vector3d> PlacementEstimator::rotation_axis_forward() const
   if (!(opt_.rotation_axis_max_ratio > 0.0) || !bout_levelled_ || !(cov_w_.trace() > 0.0) ||
       !(sum_up_walk_.norm() > 0.0))
     return std::nullopt;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov_w_);  // ascending eigenvalues
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(cov_w_);  // closed form (called per walking sample); ascending eigenvalues
   if (es.info() != Eigen::Success || !(es.eigenvalues()(2) > 0.0) ||
       es.eigenvalues()(1) > opt_.rotation_axis_max_ratio * es.eigenvalues()(2))
     return std::nullopt;
