@@ -110,6 +110,11 @@ void GyroTurnTracker::feed(const AccelSample& s) {
   }
   if (!tilt_ok_ && have_gravity_ && window_full && opt_.tilt_tau_s > 0.0) {  // starts level from the mean, once
     attitude_ = Eigen::Quaterniond::FromTwoVectors(up_, Eigen::Vector3d::UnitZ());
+    // the gyro frame's "north" is the yaw axis' start direction: its yaw starts at 0, as the
+    // vertical-rate integral does (initial_heading_rad is the reference axis' heading then)
+    const Eigen::Vector3d v = attitude_ * yaw_axis_;
+    if (std::hypot(v.x(), v.y()) >= 0.2)
+      attitude_ = (Eigen::Quaterniond(Eigen::AngleAxisd(std::atan2(v.x(), v.y()), Eigen::Vector3d::UnitZ())) * attitude_).normalized();
     tilt_up_ = up_;
     tilt_ok_ = true;
     update_axis_yaw();

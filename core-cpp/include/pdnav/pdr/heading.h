@@ -41,11 +41,11 @@ struct TurnOptions {
   double straight_threshold_rad = 15 * kDegToRad;  // |displacement| in a window below this = straight
   double report_threshold_rad = 30 * kDegToRad;  // APT: a turn is reported past 30 degrees
   double gap_reset_s = 0.5;                      // gyro/accel gap that resets the integration
-  // Instantaneous gravity for the yaw integral and the compass: a gyro-propagated tilt pulled
+  // Attitude for the reference axis' yaw and the compass's gravity: gyro-propagated, pulled
   // toward the specific force with this time constant (Mahony, Hamel, Pflimlin, IEEE TAC 2008;
   // as the placement's tilt filter). A phone in a pocket or a swinging hand tilts by tens of
-  // degrees every stride: about APT's held 1 s mean the integral mixes that swing into the yaw
-  // and the compass, so their sum (the heading offset) never holds still. 0 = APT's 1 s mean.
+  // degrees every stride: about APT's held 1 s mean the yaw and the compass mix that swing
+  // differently, so their sum (the heading offset) never holds still. 0 = APT's 1 s mean.
   double tilt_tau_s = 1.0;
 };
 
