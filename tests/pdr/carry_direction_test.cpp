@@ -61,9 +61,11 @@ Recording read_tyrex(const std::string& name) {
 
 /// Walking direction (phone axes) of the longest placement bout after feeding the recording up
 /// to until_s (the walker lowers the phone at the very end of some recordings).
-PlacementBout longest_bout(const Recording& r, bool with_gyro, double until_s = 110.0) {
+PlacementBout longest_bout(const Recording& r, bool with_gyro, double until_s = 110.0,
+                           double rotation_axis_max_ratio = PlacementOptions{}.rotation_axis_max_ratio) {
   PdrOptions o;
   o.heading.mount = Mount::kAuto;
+  o.placement.rotation_axis_max_ratio = rotation_axis_max_ratio;
   Pdr pdr(o);
   std::size_t g = 0;
   const TimeNs until_ns = s_to_ns(until_s);
@@ -92,15 +94,16 @@ struct Case {
   double tolerance_deg;
 };
 
-// Tolerances: the estimate's measured error plus ~15 deg. In trouser pockets the correlation
-// direction sits about 25 deg to the side of the truth; phone at the ear
-// and swinging hand within 10 deg. Before issue 27 (2 s mean gravity, upright prior -Z): front
-// pocket 158 deg off, phone at the ear 94-99 deg, swinging (NoDist) 114 deg.
+// Tolerances: the estimate's measured error plus ~10-15 deg. Measured: trouser pockets -17..-4
+// deg (the perpendicular of the gait rotation axis; the correlation direction alone sits 22-25
+// deg to the side), phone at the ear -6..+10, swinging hand +1..+15, texting -6..-3. Before
+// issue 27 (2 s mean gravity, upright prior -Z): front pocket 158 deg off, phone at the ear
+// 94-99 deg, swinging (NoDist) 114 deg.
 const Case kCases[] = {
-    {"Guillaume_Nexus5_NoDist_FrontPocket", {0.305, -0.247, 0.92}, {0.28, 0.95, 0.16}, 40.0},
-    {"Guillaume_Nexus5_Dist_FrontPocket", {0.318, -0.251, 0.914}, {0.28, 0.95, 0.16}, 40.0},
-    {"Guillaume_Nexus5_NoDist_BackPocket", {0.376, -0.388, -0.842}, {0.13, 0.92, -0.37}, 40.0},
-    {"Guillaume_Nexus5_Dist_BackPocket", {0.381, -0.409, -0.829}, {0.2, 0.91, -0.36}, 40.0},
+    {"Guillaume_Nexus5_NoDist_FrontPocket", {0.305, -0.247, 0.92}, {0.28, 0.95, 0.16}, 30.0},
+    {"Guillaume_Nexus5_Dist_FrontPocket", {0.318, -0.251, 0.914}, {0.28, 0.95, 0.16}, 30.0},
+    {"Guillaume_Nexus5_NoDist_BackPocket", {0.376, -0.388, -0.842}, {0.13, 0.92, -0.37}, 30.0},
+    {"Guillaume_Nexus5_Dist_BackPocket", {0.381, -0.409, -0.829}, {0.2, 0.91, -0.36}, 30.0},
     {"Guillaume_Nexus5_NoDist_Phoning", {0.861, -0.504, 0.069}, {0.49, 0.8, -0.35}, 25.0},
     {"Guillaume_Nexus5_Dist_Phoning", {0.89, -0.433, 0.143}, {0.45, 0.79, -0.41}, 25.0},
     {"Guillaume_Nexus5_NoDist_Swinging", {-0.921, 0.039, 0.387}, {0.11, -0.93, 0.35}, 25.0},
@@ -136,4 +139,28 @@ TEST(PdrCarryDirection, WithoutTheGyroscopeAPocketWalkIsNotLevelled) {
   std::printf("front pocket: error %+.1f deg levelled, %+.1f deg with the 2 s mean\n", with, without);
   EXPECT_LT(std::abs(with), 40.0);
   EXPECT_GT(std::abs(without), 60.0);
+}
+
+TEST(PdrCarryDirection, InTrouserPocketsTheGaitRotationAxisBeatsTheCorrelationDirection) {
+  // The four pocket recordings, once with the rotation axis (default) and once with the lagged
+  // correlation vector alone (rotation_axis_max_ratio = 0): the thigh swings about the body's
+  // medio-lateral axis, and the walking direction is square to it. Measured: mean |error| 10.4
+  // deg with the axis (-11, -17, -10, -4), 23.2 deg without (+25, -22, -23, -23, the second being the
+  // upright prior that the axis replaces).
+  double with_sum = 0.0, without_sum = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    const Case& c = kCases[i];
+    SCOPED_TRACE(c.name);
+    const Recording r = read_tyrex(c.name);
+    const double with = angle_about_up_deg(c.truth_forward, longest_bout(r, true).forward_phone, c.truth_up);
+    const double without =
+        angle_about_up_deg(c.truth_forward, longest_bout(r, true, 110.0, 0.0).forward_phone, c.truth_up);
+    std::printf("%-38s error %+6.1f deg with the rotation axis, %+6.1f deg with the correlation alone\n", c.name,
+                with, without);
+    EXPECT_LT(std::abs(with), 20.0);
+    with_sum += std::abs(with);
+    without_sum += std::abs(without);
+  }
+  EXPECT_LT(with_sum / 4.0, 14.0);
+  EXPECT_LT(with_sum, 0.7 * without_sum);
 }

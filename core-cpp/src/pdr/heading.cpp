@@ -1,6 +1,7 @@
 // Rotation-vector / compass heading and APT's gyro re-orientation (Zhu/Li/Chen 2013, Sec. V-B).
 #include "pdnav/pdr/heading.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -78,6 +79,16 @@ void GyroTurnTracker::feed(const AccelSample& s) {
     acc_window_.clear();
     acc_sum_.setZero();
   }
+  const double dt_acc = have_acc_last_ ? ns_to_s(s.t_ns - acc_last_ns_) : 0.0;
+  const double a_norm = s.acc_mps2.norm();
+  if (tilt_ok_ && dt_acc > 0.0 && a_norm > 1e-6) {
+    // the attitude's up pulled toward the specific force (Mahony): the smallest rotation of the
+    // phone that moves it there, about a horizontal axis (the yaw is left to the gyro)
+    const Eigen::Vector3d target =
+        (tilt_up_ + std::min(1.0, dt_acc / opt_.tilt_tau_s) * (s.acc_mps2 / a_norm - tilt_up_)).normalized();
+    attitude_ = (attitude_ * Eigen::Quaterniond::FromTwoVectors(target, tilt_up_)).normalized();
+    tilt_up_ = attitude_.conjugate() * Eigen::Vector3d::UnitZ();
+  }
   have_acc_last_ = true;
   acc_last_ns_ = s.t_ns;
   acc_window_.emplace_back(s.t_ns, s.acc_mps2);
@@ -97,6 +108,35 @@ void GyroTurnTracker::feed(const AccelSample& s) {
       have_gravity_ = true;
     }
   }
+  if (!tilt_ok_ && have_gravity_ && window_full && opt_.tilt_tau_s > 0.0) {  // starts level from the mean, once
+    attitude_ = Eigen::Quaterniond::FromTwoVectors(up_, Eigen::Vector3d::UnitZ());
+    // the gyro frame's "north" is the yaw axis' start direction: its yaw starts at 0, as the
+    // vertical-rate integral does (initial_heading_rad is the reference axis' heading then)
+    const Eigen::Vector3d v = attitude_ * yaw_axis_;
+    if (std::hypot(v.x(), v.y()) >= 0.2)
+      attitude_ = (Eigen::Quaterniond(Eigen::AngleAxisd(std::atan2(v.x(), v.y()), Eigen::Vector3d::UnitZ())) * attitude_).normalized();
+    tilt_up_ = up_;
+    tilt_ok_ = true;
+    update_axis_yaw();
+  }
+}
+
+void GyroTurnTracker::set_yaw_axis(const Eigen::Vector3d& axis_phone) {
+  if (!axis_phone.allFinite() || axis_phone.norm() < 1e-9) return;
+  if ((axis_phone.normalized() - yaw_axis_).norm() < 1e-12) return;
+  yaw_axis_ = axis_phone.normalized();
+  axis_yaw_init_ = false;  // another axis: its yaw starts from its own heading in the gyro frame
+  update_axis_yaw();
+}
+
+void GyroTurnTracker::update_axis_yaw() {
+  if (!tilt_ok_) return;
+  const Eigen::Vector3d v = attitude_ * yaw_axis_;
+  if (std::hypot(v.x(), v.y()) < 0.2) return;  // near vertical: held
+  const double yaw = -std::atan2(v.x(), v.y());  // heading clockwise from the frame's +y; yaw = -heading
+  axis_yaw_rad_ = axis_yaw_init_ ? axis_yaw_rad_ + wrap_pi(yaw - axis_yaw_wrapped_) : yaw;
+  axis_yaw_init_ = true;
+  axis_yaw_wrapped_ = yaw;
 }
 
 void GyroTurnTracker::feed(const GyroSample& s) {
@@ -110,9 +150,22 @@ void GyroTurnTracker::feed(const GyroSample& s) {
     state_ = State::kStraight;
   }
   if (integrate) {
-    // Trapezoidal angular displacement, projected on the vertical (APT Sec. V-B).
+    // Trapezoidal angular displacement, projected on the vertical (APT Sec. V-B): about the
+    // attitude's instantaneous gravity (the same rotation carries the attitude), else about the
+    // held mean
     const double dt = ns_to_s(s.t_ns - gyro_last_ns_);
-    yaw_rad_ += 0.5 * (s.rate_radps + gyro_last_).dot(up_) * dt;
+    const Eigen::Vector3d w = 0.5 * (s.rate_radps + gyro_last_);
+    if (tilt_ok_) {
+      const Eigen::Vector3d before = tilt_up_;
+      const double angle = w.norm() * dt;
+      if (angle > 0.0)
+        attitude_ = (attitude_ * Eigen::Quaterniond(Eigen::AngleAxisd(angle, w.normalized()))).normalized();
+      tilt_up_ = attitude_.conjugate() * Eigen::Vector3d::UnitZ();
+      yaw_rad_ += w.dot(0.5 * (before + tilt_up_)) * dt;
+      update_axis_yaw();
+    } else {
+      yaw_rad_ += w.dot(up_) * dt;
+    }
   }
   have_gyro_last_ = true;
   gyro_last_ns_ = s.t_ns;

@@ -22,7 +22,9 @@ Pdr::Pdr(const PdrOptions& options)
       fusion_(options.fusion),
       qsf_(options.fusion),
       magcal_(options.magcal),
-      fusion_reference_(placement_.reference_phone()) {}  // readings before the first bout use it
+      fusion_reference_(placement_.reference_phone()) {  // readings before the first bout use it
+  tracker_.set_yaw_axis(reference_axis());
+}
 
 void Pdr::set_location(const geo::Geodetic& where, std::int64_t utc_ms) {
   const geo::Declination d = geo::declination_at(where, utc_ms);
@@ -88,6 +90,7 @@ void Pdr::sync_placement() {
     qsf_.reset();  // the offset refers to the reference axis
   }
   fusion_reference_ = placement_.reference_phone();
+  tracker_.set_yaw_axis(reference_axis());
 }
 
 const char* to_string(HeadingSource s) {
@@ -121,7 +124,7 @@ void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight, H
   abs_weight_ns_ = t_ns;
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s &&
                          tracker_.has_gravity();
-  fusion_.add(t_ns, heading_mag_rad, tracker_.yaw_rad(), weight, gyro_live);
+  fusion_.add(t_ns, heading_mag_rad, tracker_.axis_yaw_rad(), weight, gyro_live);
   have_heading_ = true;
   ref_t_ns_ = t_ns;
 }
@@ -386,7 +389,7 @@ void Pdr::feed(const MagSample& s) {
       compass_heading_rad(field_ut, tracker_.up_phone(), reference_axis(), opt_.heading.min_horizontal);
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(s.t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
   if (compass && gyro_live) {
-    qsf_.add(s.t_ns, *compass + tracker_.yaw_rad(), field_ut.norm());
+    qsf_.add(s.t_ns, *compass + tracker_.axis_yaw_rad(), field_ut.norm());
     ++counters_.mag_readings_qsf_tested;
     counters_.mag_readings_quasi_static += qsf_.quasi_static();
   } else {
@@ -476,7 +479,7 @@ bool Pdr::android_active(TimeNs t_ns) const {
 }
 
 double Pdr::heading_rad() const {
-  const double yaw = tracker_.yaw_rad();
+  const double yaw = tracker_.axis_yaw_rad();
   const double offset = opt_.heading.mount == Mount::kAuto ? placement_.forward_offset_rad() : 0.0;
   if (!fusion_.valid()) return wrap_two_pi(opt_.heading.initial_heading_rad - yaw + offset);
   return wrap_two_pi(fusion_.heading_mag_rad(yaw, latest_ns_) + offset + declination_rad_);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 namespace pdnav::pdr {
@@ -33,6 +34,8 @@ void PlacementEstimator::start_bout(TimeNs t_ns) {
   bout_up_ = up_;
   corr_.setZero();
   cov_h_.setZero();
+  cov_w_.setZero();
+  sum_up_walk_.setZero();
   var_v_ = n_corr_ = walking_s_ = 0.0;
   prior_supported_ = reversed_ = prior_rejected_ = bout_levelled_ = false;
   // placement from the dominant gravity axis; the reference axis is the placement's prior
@@ -56,6 +59,18 @@ void PlacementEstimator::start_bout(TimeNs t_ns) {
 
 void PlacementEstimator::feed(const GyroSample& s) {
   if (!s.rate_radps.allFinite()) return;
+  // the gait band of the angular rate (the same first-order high-pass as the acceleration's)
+  const double dt = w_hp_ns_ >= 0 ? ns_to_s(s.t_ns - w_hp_ns_) : -1.0;
+  if (dt > 0.0 && dt <= 0.5 && opt_.gait_highpass_hz > 0.0) {
+    const double a = 1.0 / (1.0 + 2.0 * kPi * opt_.gait_highpass_hz * dt);
+    w_hp_out_ = a * (w_hp_out_ + s.rate_radps - w_hp_in_);
+    w_hp_in_ = s.rate_radps;
+    w_hp_ns_ = s.t_ns;
+  } else if (w_hp_ns_ < 0 || dt > 0.5) {  // first sample or after a gap: the filter restarts
+    w_hp_in_ = s.rate_radps;
+    w_hp_out_.setZero();
+    w_hp_ns_ = s.t_ns;
+  }  // a duplicate or backwards sample leaves the filter as it is
   gyro_radps_ = s.rate_radps;
   gyro_ns_ = s.t_ns;
 }
@@ -132,6 +147,11 @@ void PlacementEstimator::feed(const AccelSample& s, bool walking) {
     const Eigen::Vector3d& hl = hist_.front().second;
     corr_ += av * hl;
     cov_h_ += hl * hl.transpose();
+    if (level) {  // the horizontal part of the gait-band angular rate about the instantaneous gravity
+      const Eigen::Vector3d w_h = w_hp_out_ - w_hp_out_.dot(tilt_up_) * tilt_up_;
+      cov_w_ += w_h * w_h.transpose();
+      sum_up_walk_ += tilt_up_;
+    }
     var_v_ += av * av;
     n_corr_ += 1.0;
     walking_s_ += dt;
@@ -172,7 +192,11 @@ void PlacementEstimator::update_forward() {
     // body, and the unlevelled correlation's direction scatters 32 deg around it on ILC)
     const Eigen::Vector3d prior_axis = -Eigen::Vector3d::UnitZ();
     const Eigen::Vector3d ph = prior_axis - prior_axis.dot(up_) * up_;
-    if (trusted && walking_s_ >= opt_.prior_check_s && d.norm() > 1e-9 && ph.norm() > 0.2) {
+    // A dominant horizontal rotation axis (a limb carry: trouser pocket, swinging hand) is direct
+    // evidence of the walking direction and replaces the prior too
+    if (trusted && walking_s_ >= opt_.prior_check_s && rotation_axis_forward()) {
+      prior_rejected_ = true;
+    } else if (trusted && walking_s_ >= opt_.prior_check_s && d.norm() > 1e-9 && ph.norm() > 0.2) {
       const double cos_line = std::abs(d.normalized().dot(ph.normalized()));
       prior_rejected_ = cos_line < std::cos(opt_.prior_max_angle_rad);
     }
@@ -189,9 +213,11 @@ void PlacementEstimator::update_forward() {
     bout_.forward_phone = reversed_ ? Eigen::Vector3d(-prior) : prior;
     return;
   }
-  // other placements (and a rejected prior): the lagged correlation vector, horizontal part
+  // other placements (and a rejected prior): the perpendicular of the dominant rotation axis
+  // signed by the lagged correlation, else the correlation vector itself (horizontal parts)
   if (trusted && d.norm() > 1e-9) {
     d.normalize();
+    if (const auto f = rotation_axis_forward()) d = f->dot(d) >= 0.0 ? *f : Eigen::Vector3d(-*f);
     bout_.forward_phone = d;
     const double vf = d.dot(cov_h_ * d);
     bout_.phase_corr = vf > 0.0 ? d.dot(corr_) / std::sqrt(var_v_ * vf) : 0.0;
@@ -199,6 +225,20 @@ void PlacementEstimator::update_forward() {
     bout_.forward_phone = reference_;
     bout_.phase_corr = 0.0;
   }
+}
+
+std::optional<Eigen::Vector3d> PlacementEstimator::rotation_axis_forward() const {
+  if (!(opt_.rotation_axis_max_ratio > 0.0) || !bout_levelled_ || !(cov_w_.trace() > 0.0) ||
+      !(sum_up_walk_.norm() > 0.0))
+    return std::nullopt;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(cov_w_);  // closed form (called per walking sample); ascending eigenvalues
+  if (es.info() != Eigen::Success || !(es.eigenvalues()(2) > 0.0) ||
+      es.eigenvalues()(1) > opt_.rotation_axis_max_ratio * es.eigenvalues()(2))
+    return std::nullopt;
+  const Eigen::Vector3d f = sum_up_walk_.normalized().cross(es.eigenvectors().col(2));
+  if (f.norm() < 0.5) return std::nullopt;  // (the axis is horizontal by construction)
+  return Eigen::Vector3d(f.normalized());
 }
 
 double PlacementEstimator::forward_offset_rad() const {

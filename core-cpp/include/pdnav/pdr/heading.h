@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "pdnav/geo/events.h"
 #include "pdnav/geo/samples.h"
@@ -40,6 +41,12 @@ struct TurnOptions {
   double straight_threshold_rad = 15 * kDegToRad;  // |displacement| in a window below this = straight
   double report_threshold_rad = 30 * kDegToRad;  // APT: a turn is reported past 30 degrees
   double gap_reset_s = 0.5;                      // gyro/accel gap that resets the integration
+  // Attitude for the reference axis' yaw and the compass's gravity: gyro-propagated, pulled
+  // toward the specific force with this time constant (Mahony, Hamel, Pflimlin, IEEE TAC 2008;
+  // as the placement's tilt filter). A phone in a pocket or a swinging hand tilts by tens of
+  // degrees every stride: about APT's held 1 s mean the yaw and the compass mix that swing
+  // differently, so their sum (the heading offset) never holds still. 0 = APT's 1 s mean.
+  double tilt_tau_s = 1.0;
 };
 
 struct HeadingOptions {
@@ -68,7 +75,9 @@ std::optional<double> compass_heading_rad(const Eigen::Vector3d& field_phone, co
                                           const Eigen::Vector3d& forward_phone, double min_horizontal = 0.25);
 
 /// APT's gyro re-orientation: integrates the gyro about the estimated gravity (yaw, positive =
-/// counter-clockwise seen from above = left) and reports turns.
+/// counter-clockwise seen from above = left) and reports turns. With tilt_tau_s > 0 it also
+/// keeps a gyro-propagated, accelerometer-levelled attitude: the instantaneous gravity and the
+/// yaw of one phone axis (axis_yaw_rad(), the heading fusion's reference axis).
 class GyroTurnTracker {
  public:
   explicit GyroTurnTracker(const TurnOptions& options = {});
@@ -78,9 +87,18 @@ class GyroTurnTracker {
 
   /// Integrated yaw about the vertical since start (rad, left positive); valid once gravity is known.
   double yaw_rad() const { return yaw_rad_; }
+  /// The phone axis whose heading axis_yaw_rad() follows (the heading filter's reference axis).
+  void set_yaw_axis(const Eigen::Vector3d& axis_phone);
+  /// Yaw (rad, left positive, continuous) of the yaw axis' horizontal projection in the
+  /// gyro-propagated attitude (tilt_tau_s > 0), else yaw_rad(). Unlike the integral of the
+  /// vertical rate, it has no coning drift: a phone swung about two axes at once (a running
+  /// pocket) accumulates the area its swing encloses in that integral, several deg/s. Held
+  /// while the axis is within ~12 deg of the vertical.
+  double axis_yaw_rad() const { return tilt_ok_ ? axis_yaw_rad_ : yaw_rad_; }
   bool has_gravity() const { return have_gravity_; }
-  /// Unit "up" vector in phone axes (mean specific force while walking straight).
-  const Eigen::Vector3d& up_phone() const { return up_; }
+  /// Unit "up" vector in phone axes: the tilt filter's instantaneous gravity (tilt_tau_s > 0),
+  /// else the mean specific force while walking straight.
+  const Eigen::Vector3d& up_phone() const { return tilt_ok_ ? tilt_up_ : up_; }
   bool straight() const { return state_ == State::kStraight; }
   std::vector<PdrTurn> take_turns();
   const SampleCounters& gyro_counters() const { return gyro_counters_; }
@@ -106,6 +124,14 @@ class GyroTurnTracker {
   TimeNs acc_last_ns_ = 0;
   Eigen::Vector3d up_ = Eigen::Vector3d::UnitZ();
   bool have_gravity_ = false;
+  Eigen::Vector3d tilt_up_ = Eigen::Vector3d::UnitZ();  // tilt filter (tilt_tau_s > 0): up in phone axes
+  bool tilt_ok_ = false;
+  Eigen::Quaterniond attitude_ = Eigen::Quaterniond::Identity();  // phone -> level gyro frame
+  Eigen::Vector3d yaw_axis_ = Eigen::Vector3d::UnitY();
+  double axis_yaw_rad_ = 0.0;   // continuous
+  double axis_yaw_wrapped_ = 0.0;
+  bool axis_yaw_init_ = false;
+  void update_axis_yaw();
   // gyro integration
   bool have_gyro_last_ = false;
   TimeNs gyro_last_ns_ = 0;

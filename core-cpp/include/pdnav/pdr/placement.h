@@ -23,11 +23,14 @@
 // placement.cpp), the 2 s mean is used. The upright prior axis (-Z) stands only while the
 // motion's direction is within prior_max_angle_rad of its line (a phone at the ear or in a
 // trouser pocket is upright too, but walks along +-X or obliquely).
+// Limb carries (pocket, swinging hand): the walking direction is square to the dominant
+// horizontal axis of the gait rotation (rotation_axis_max_ratio), signed by the correlation.
 // One constant offset per placement bout; a bout ends when the gravity direction in phone
 // axes moves by more than change_angle_rad for change_hold_s (the phone was moved).
 #pragma once
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -66,6 +69,13 @@ struct PlacementOptions {
   // this from the prior's line, after this much walking (halfway between the axes).
   double prior_max_angle_rad = 45 * kDegToRad;
   double prior_check_s = 4.0;
+  // Limb carries (trouser pocket, swinging hand): the gait turns the phone about the body's
+  // medio-lateral axis (hip / shoulder flexion), a horizontal axis square to the walk. The
+  // walking direction is then up x (the dominant axis of the levelled, gait-band angular rate),
+  // signed by the phase correlation (docs/pdr.md "Rotation axis"). Used when that axis
+  // dominates: second / largest eigenvalue of sum w_h w_h^T below rotation_axis_max_ratio
+  // (TYREX pockets and swinging 0.12-0.36, phone at the ear 0.57-0.80); 0 = off.
+  double rotation_axis_max_ratio = 0.5;
 };
 
 /// A placement bout: from t_start_ns to t_end_ns (last sample so far for the open one).
@@ -129,6 +139,8 @@ class PlacementEstimator {
   void start_bout(TimeNs t_ns);
   void update_forward();
   Eigen::Vector3d gait_band(const Eigen::Vector3d& lin, double dt_s);
+  // the walking direction from the dominant horizontal gait rotation axis (unsigned), if any
+  std::optional<Eigen::Vector3d> rotation_axis_forward() const;
   double flip_threshold() const;
 
   PlacementOptions opt_;
@@ -153,6 +165,10 @@ class PlacementEstimator {
   bool reversed_ = false;  // the bout's prior axis has been reversed
   double var_v_ = 0.0, n_corr_ = 0.0;
   Eigen::Matrix3d cov_h_ = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d cov_w_ = Eigen::Matrix3d::Zero();  // levelled gait-band angular rate, walking (phone axes)
+  Eigen::Vector3d sum_up_walk_ = Eigen::Vector3d::Zero();  // tilt filter's up while walking (phone axes)
+  Eigen::Vector3d w_hp_in_ = Eigen::Vector3d::Zero(), w_hp_out_ = Eigen::Vector3d::Zero();
+  TimeNs w_hp_ns_ = -1;
   double walking_s_ = 0.0;
   bool prior_supported_ = false;  // running phase correlation along the prior axis > 0
   bool prior_rejected_ = false;   // the motion's direction is off the prior's line
