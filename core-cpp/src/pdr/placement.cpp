@@ -186,6 +186,8 @@ Eigen::Vector3d PlacementEstimator::gait_band(const Eigen::Vector3d& lin, double
 void PlacementEstimator::update_forward() {
   const bool trusted = walking_s_ >= opt_.min_bout_s && var_v_ > 0.0;
   Eigen::Vector3d d = corr_ - corr_.dot(up_) * up_;  // the motion's direction (horizontal)
+  // the limb-carry evidence, once per update (an eigen-decomposition, per walking sample)
+  const std::optional<Eigen::Vector3d> axis_forward = trusted ? rotation_axis_forward() : std::nullopt;
   if (bout_.placement == Placement::kUpright) {
     // the upright prior's line against the motion's (levelled) direction, once the correlation
     // has settled; the flat prior stands (hand-held texting: the phone is held square to the
@@ -194,7 +196,7 @@ void PlacementEstimator::update_forward() {
     const Eigen::Vector3d ph = prior_axis - prior_axis.dot(up_) * up_;
     // A dominant horizontal rotation axis (a limb carry: trouser pocket, swinging hand) is direct
     // evidence of the walking direction and replaces the prior too
-    if (trusted && walking_s_ >= opt_.prior_check_s && rotation_axis_forward()) {
+    if (trusted && walking_s_ >= opt_.prior_check_s && axis_forward) {
       prior_rejected_ = true;
     } else if (trusted && walking_s_ >= opt_.prior_check_s && d.norm() > 1e-9 && ph.norm() > 0.2) {
       const double cos_line = std::abs(d.normalized().dot(ph.normalized()));
@@ -217,7 +219,7 @@ void PlacementEstimator::update_forward() {
   // signed by the lagged correlation, else the correlation vector itself (horizontal parts)
   if (trusted && d.norm() > 1e-9) {
     d.normalize();
-    if (const auto f = rotation_axis_forward()) d = f->dot(d) >= 0.0 ? *f : Eigen::Vector3d(-*f);
+    if (axis_forward) d = axis_forward->dot(d) >= 0.0 ? *axis_forward : Eigen::Vector3d(-*axis_forward);
     bout_.forward_phone = d;
     const double vf = d.dot(cov_h_ * d);
     bout_.phase_corr = vf > 0.0 ? d.dot(corr_) / std::sqrt(var_v_ * vf) : 0.0;
