@@ -283,6 +283,12 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
                           {"bias_ut", {cal.bias_ut().x(), cal.bias_ut().y(), cal.bias_ut().z()}},
                           {"radius_ut", std::isfinite(cal.radius_ut()) ? nlohmann::json(cal.radius_ut()) : nlohmann::json()},
                           {"residual", std::isfinite(cal.residual()) ? nlohmann::json(cal.residual()) : nlohmann::json()},
+                          {"method", cal.gyro_aided() ? "gyro-aided pairs" : "sphere"},
+                          {"active_from_s", cal.active_from_ns() >= 0 ? nlohmann::json(ns_to_s(cal.active_from_ns() - t0_ns)) : nlohmann::json()},
+                          {"gyro_bias_dps", {rad_to_deg(cal.gyro_bias_radps().x()), rad_to_deg(cal.gyro_bias_radps().y()), rad_to_deg(cal.gyro_bias_radps().z())}},
+                          {"pairs_gated", cal.pairs_gated()},
+                          {"pair_residual_ut", std::isfinite(cal.pair_residual_ut()) ? nlohmann::json(cal.pair_residual_ut()) : nlohmann::json()},
+                          {"bias_sigma_ut", std::isfinite(cal.bias_sigma_ut()) ? nlohmann::json(cal.bias_sigma_ut()) : nlohmann::json()},
                           {"fits_accepted", cal.fits_accepted()},
                           {"fits_refused", cal.refusals()}};
   nlohmann::json bouts = nlohmann::json::array();

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
@@ -14,6 +15,34 @@ void MagCalibration::clear_sums() {
   sm_.setZero();
   sym_.setZero();
   smm_.setZero();
+  pn_.setZero();
+  pr_.setZero();
+  pyy_ = pw_ = 0.0;
+}
+
+namespace {
+Eigen::Quaterniond exp_rotation(const Eigen::Vector3d& v_rad) {
+  const double a = v_rad.norm();
+  if (!(a > 1e-12)) return Eigen::Quaterniond::Identity();
+  return Eigen::Quaterniond(Eigen::AngleAxisd(a, v_rad / a));
+}
+}  // namespace
+
+void MagCalibration::add_gyro(TimeNs t_ns, const Eigen::Vector3d& rate_radps) {
+  if (!opt_.enabled || !opt_.gyro_aided || !rate_radps.allFinite()) return;
+  if (gyro_ns_ >= 0) {
+    if (t_ns <= gyro_ns_) return;  // duplicate or backwards
+    const double dt_s = ns_to_s(t_ns - gyro_ns_);
+    if (dt_s > opt_.max_gyro_gap_s) {
+      readings_.clear();  // the attitude over the gap is unknown: no pair across it
+    } else {
+      const Eigen::Matrix3d r0 = q_.toRotationMatrix();
+      q_ = (q_ * exp_rotation(0.5 * (rate_ + rate_radps) * dt_s)).normalized();  // trapezoid
+      s_ += 0.5 * dt_s * (r0 + q_.toRotationMatrix());
+    }
+  }
+  rate_ = rate_radps;
+  gyro_ns_ = t_ns;
 }
 
 void MagCalibration::add(TimeNs t_ns, const Eigen::Vector3d& field_ut) {
@@ -22,6 +51,106 @@ void MagCalibration::add(TimeNs t_ns, const Eigen::Vector3d& field_ut) {
   const double dt_s = have_last_ ? ns_to_s(t_ns - last_ns_) : opt_.sample_interval_s;
   have_last_ = true;
   last_ns_ = t_ns;
+  const bool live = opt_.gyro_aided && gyro_ns_ >= 0 && std::abs(ns_to_s(t_ns - gyro_ns_)) <= opt_.max_gyro_gap_s;
+  if (live != gyro_live_) {  // the other fit starts afresh (the bias in use stays)
+    clear_sums();
+    readings_.clear();
+    gyro_live_ = live;
+  }
+  if (live) add_pairs(t_ns, field_ut, dt_s);
+  else add_sphere(t_ns, field_ut, dt_s);
+}
+
+void MagCalibration::add_pairs(TimeNs t_ns, const Eigen::Vector3d& m, double dt_s) {
+  const double decay = std::exp(-dt_s / opt_.tau_s);
+  pn_ *= decay, pr_ *= decay, pyy_ *= decay, pw_ *= decay;
+  // the attitude at t_ns: the last gyro sample's, carried to t_ns with its rate
+  const double ahead_s = ns_to_s(t_ns - gyro_ns_);
+  const Eigen::Matrix3d r = (q_ * exp_rotation(rate_ * ahead_s)).normalized().toRotationMatrix();
+  const Eigen::Matrix3d s_now = s_ + ahead_s * r;
+  const Eigen::Vector3d rm = r * m;
+  int lags = 0;
+  for (double lag = 1.0; lag <= opt_.max_lag_s + 1e-9; lag *= 2.0) ++lags;
+  const double w = std::min(dt_s, opt_.max_weight_s) / std::max(1, lags);
+  const double min_cos = std::cos(opt_.min_pair_rotation_rad);
+  for (double lag = 1.0; lag <= opt_.max_lag_s + 1e-9; lag *= 2.0) {
+    const TimeNs target = t_ns - s_to_ns(lag);
+    auto it = std::lower_bound(readings_.begin(), readings_.end(), target,
+                               [](const Reading& x, TimeNs v) { return x.t_ns < v; });
+    if (it == readings_.end() || (it != readings_.begin() && target - (it - 1)->t_ns < it->t_ns - target)) {
+      if (it == readings_.begin()) continue;
+      --it;
+    }
+    if (std::llabs(it->t_ns - target) > s_to_ns(opt_.sample_interval_s)) continue;
+    // rotation between the two readings: cos = (trace(R_i^T R_j) - 1) / 2
+    if (0.5 * ((r.transpose() * it->r).trace() - 1.0) > min_cos) continue;
+    // the field in the world-fixed frame at the linearisation point (the latest b)
+    const Eigen::Vector3d h = 0.5 * (rm + it->r * it->m - (r + it->r) * pair_b_);
+    Eigen::Matrix3d hx;
+    hx << 0.0, -h.z(), h.y(), h.z(), 0.0, -h.x(), -h.y(), h.x(), 0.0;
+    Eigen::Matrix<double, 3, 6> a;
+    a << r - it->r, -hx * (s_now - it->s);
+    const Eigen::Vector3d y = rm - it->r * it->m;
+    if (pair_solved_) {
+      Vec6 x_prev;
+      x_prev << pair_b_, gyro_bias_radps_;
+      const double gate = opt_.pair_gate_sigma * std::max(pair_residual_ut_, opt_.pair_noise_ut);
+      if ((y - a * x_prev).norm() > gate) {
+        ++pairs_gated_;
+        continue;
+      }
+    }
+    pn_ += w * a.transpose() * a;
+    pr_ += w * a.transpose() * y;
+    pyy_ += w * y.squaredNorm();
+    pw_ += w;
+  }
+  readings_.push_back({t_ns, m, r, s_now});
+  while (!readings_.empty() && readings_.front().t_ns < t_ns - s_to_ns(opt_.max_lag_s + 1.0)) readings_.pop_front();
+  if (pw_ < opt_.min_pair_time_s) return;
+
+  // weighted least squares with the priors b ~ N(0, prior^2), d ~ N(0, prior_gyro^2): the ridge
+  // of each is N_eff noise^2 / prior^2
+  const double n2 = opt_.correlation_time_s * opt_.pair_noise_ut * opt_.pair_noise_ut;
+  Vec6 ridge;
+  ridge.head<3>().setConstant(n2 / (opt_.prior_bias_ut * opt_.prior_bias_ut));
+  ridge.tail<3>().setConstant(n2 / (opt_.prior_gyro_bias_radps * opt_.prior_gyro_bias_radps));
+  const Mat6 info = pn_ + Mat6(ridge.asDiagonal());
+  const Eigen::LDLT<Mat6> ldlt(info);
+  const Vec6 x = ldlt.solve(pr_);
+  const Eigen::Vector3d b = x.head<3>();
+  pair_b_ = b;
+  gyro_bias_radps_ = x.tail<3>();
+  pair_solved_ = true;
+  const double chi2 = std::max(0.0, pyy_ - 2.0 * x.dot(pr_) + x.dot(pn_ * x));
+  pair_residual_ut_ = std::sqrt(chi2 / pw_);
+  const double radius = (m - b).norm();
+  last_residual_ = radius > 0.0 ? pair_residual_ut_ / radius : kNaN;
+  if (!b.allFinite() || !(pair_residual_ut_ <= opt_.max_pair_residual_ut) || b.norm() > opt_.max_bias_ut) {
+    ++refusals_;  // the field changes from place to place: forget the window (the bias in use stays)
+    clear_sums();
+    pair_solved_ = false;
+    return;
+  }
+  // covariance of b (the gyro bias marginalised): noise^2 N_eff times the b block of info^-1
+  const double noise_ut = std::max(pair_residual_ut_, opt_.pair_noise_ut);
+  const Eigen::Matrix3d cov_b = noise_ut * noise_ut * opt_.correlation_time_s *
+                                ldlt.solve(Mat6::Identity()).topLeftCorner<3, 3>();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov_b, Eigen::EigenvaluesOnly);
+  // ascending variances: the second is the second best-determined direction
+  bias_sigma_ut_ = std::sqrt(std::max(0.0, eig.eigenvalues()[1]));
+  if (!(bias_sigma_ut_ <= opt_.max_bias_sigma_ut)) return;  // not turned enough yet
+  // every direction at its posterior mean: one the phone never turns about stays at the prior (0)
+  // and, being the vertical of that phone, does not move the heading
+  if (!active_) active_from_ns_ = t_ns;
+  active_ = true;
+  ++accepted_;
+  bias_ut_ = b;
+  radius_ut_ = radius;
+  residual_ = last_residual_;
+}
+
+void MagCalibration::add_sphere(TimeNs t_ns, const Eigen::Vector3d& field_ut, double dt_s) {
   const double decay = std::exp(-dt_s / opt_.tau_s);
   w_ *= decay, sy_ *= decay, syy_ *= decay, sm_ *= decay, sym_ *= decay, smm_ *= decay;
   const double w = std::min(dt_s, opt_.max_weight_s);
@@ -58,6 +187,7 @@ void MagCalibration::add(TimeNs t_ns, const Eigen::Vector3d& field_ut) {
   // the bias must explain the variation of |m|^2 (a field that changes along the walk does not
   // vary with the phone's orientation); this also leaves a small bias (a calibrated phone) alone
   if (!(last_explained_ >= opt_.min_explained)) return;
+  if (!active_) active_from_ns_ = t_ns;
   active_ = true;
   ++accepted_;
   bias_ut_ = b;

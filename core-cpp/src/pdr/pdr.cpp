@@ -357,6 +357,7 @@ void Pdr::feed(const GyroSample& s) {
   ++sensors_.gyro;
   last_cal_gyro_ns_ = s.t_ns;
   tracker_.feed(s);
+  magcal_.add_gyro(s.t_ns, s.rate_radps);  // the attitude of the gyro-aided hard-iron fit
   placement_.feed(s);  // the tilt filter levels the walking-direction correlation
   classifier_.feed(s);
   track_handling();

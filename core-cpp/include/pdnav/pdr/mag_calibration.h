@@ -1,8 +1,10 @@
 // Online hard-iron magnetometer calibration (docs/pdr.md, "Hard-iron calibration").
 #pragma once
 #include <cstdint>
+#include <deque>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "pdnav/geo/samples.h"
 #include "pdnav/geo/units.h"
@@ -18,8 +20,42 @@ namespace pdnav::pdr {
 // only yaws) stays uncorrected. The bias is applied once the readings span two directions (second
 // eigenvalue of their covariance) and the sphere fits them; a fit that does not (a magnet, steel
 // nearby: the field is disturbed, not biased) is refused and its readings are forgotten.
+//
+// While a gyroscope is live the bias is instead estimated with the attitude the gyro gives
+// (Troni & Whitcomb, "Field sensor bias calibration with angular-rate sensors", IEEE/ASME Trans.
+// Mechatronics 24(3), 2019, integrated form): the field in a frame fixed to the world is the same
+// at two nearby times, R_i (m_i - b) = R_j (m_j - b) with R the gyro-integrated attitude, so
+// (R_i - R_j) b = R_i m_i - R_j m_j is linear in b. Pairs 1-8 s apart, weighted least squares with
+// exponential forgetting and a prior on b. A turn of a quarter circle determines the horizontal
+// bias (the sphere fit needs a half turn); the direction the phone never rotates about (the
+// vertical of a phone that only yaws) stays at the prior and does not move the heading.
+// The gyro's own bias d (phone axes) tilts the integrated attitude by -R^T (integral of R dt) d;
+// to first order a pair gains the term -[h]x (S_i - S_j) d (h the field in the world-fixed frame,
+// S the integral of R), so d is estimated with b (6 unknowns, a prior on each): an uncorrected
+// 0.4 deg/s bias over an 8 s pair would otherwise be a 2.7 uT error at 48 uT.
 struct MagCalibrationOptions {
   bool enabled = true;
+  // --- gyro-aided fit (Troni & Whitcomb 2019), used while gyro samples arrive ---
+  bool gyro_aided = true;
+  double max_lag_s = 8.0;            // pairs at lags 1, 2, 4, 8 s (the world field at two places
+                                     // a few metres apart; gyro drift over 8 s is < 0.1 deg)
+  double max_gyro_gap_s = 0.2;       // a longer gap breaks the attitude: pairs restart
+  double prior_bias_ut = 30.0;       // prior 1-sigma of b (phone hard iron left after calibration)
+  double prior_gyro_bias_radps = 0.1 * kDegToRad;  // residual bias of a calibrated MEMS gyro (as HeadingFusionOptions)
+  double pair_noise_ut = 1.0;        // nominal 1-sigma of one pair's residual (two readings' noise)
+  double correlation_time_s = 1.0;   // pair residuals closer than this are one (N_eff)
+  // applied once the two best-determined directions of b are known to this 1-sigma (5.5 deg of
+  // heading at a horizontal intensity of 21 uT; a hard iron left uncorrected is tens of degrees)
+  double max_bias_sigma_ut = 2.0;
+  // a pair whose residual exceeds this many times the window's rms (at least pair_noise_ut) is
+  // left out: the field differs between the two places (a car, a rail, steel in a wall)
+  double pair_gate_sigma = 3.0;
+  // rms pair residual above which the field is disturbed everywhere: the window is forgotten,
+  // counted as refused, the bias in use stays (docs/pdr.md)
+  double max_pair_residual_ut = 3.0;
+  double min_pair_rotation_rad = 3.0 * kDegToRad;  // a pair rotated less carries ~no information
+  double min_pair_time_s = 5.0;      // weighted time of informative pairs before the first solve
+  // --- attitude-independent sphere fit (no gyroscope) ---
   double tau_s = 300.0;            // memory (the phone's hard iron is stable for hours)
   double sample_interval_s = 0.1;  // readings closer than this are one (weights in seconds: rate-free)
   double max_weight_s = 0.5;       // weight of one reading after a gap, at most
@@ -52,11 +88,25 @@ class MagCalibration {
   explicit MagCalibration(const MagCalibrationOptions& options = {}) : opt_(options) {}
   /// One reading (phone axes, uT). Non-finite readings and backwards time are ignored.
   void add(TimeNs t_ns, const Eigen::Vector3d& field_ut);
+  /// One calibrated gyroscope sample (phone axes, rad/s): the attitude of the gyro-aided fit.
+  void add_gyro(TimeNs t_ns, const Eigen::Vector3d& rate_radps);
+  /// The gyro-aided fit is in use (a gyroscope is live); false: the sphere fit.
+  bool gyro_aided() const { return gyro_live_; }
+  /// rms residual of the gyro-aided pairs over the window (uT; NaN before the first solve) and
+  /// the 1-sigma of the second best-determined direction of b.
+  double pair_residual_ut() const { return pair_residual_ut_; }
+  double bias_sigma_ut() const { return bias_sigma_ut_; }
+  /// The gyro bias estimated with it (phone axes, rad/s; zero before the first solve).
+  const Eigen::Vector3d& gyro_bias_radps() const { return gyro_bias_radps_; }
+  /// Pairs left out by the per-pair gate (the field differed between the two places).
+  std::int64_t pairs_gated() const { return pairs_gated_; }
   /// The reading with the bias in use removed (unchanged while not active).
   Eigen::Vector3d corrected(const Eigen::Vector3d& field_ut) const {
     return active_ ? Eigen::Vector3d(field_ut - bias_ut_) : field_ut;
   }
   bool active() const { return active_; }
+  /// Time the first bias was applied (-1: never).
+  TimeNs active_from_ns() const { return active_from_ns_; }
   /// The bias in use (zero while not active), sphere radius and fit residual (fraction of r)
   /// of the last accepted fit.
   const Eigen::Vector3d& bias_ut() const { return bias_ut_; }
@@ -72,7 +122,28 @@ class MagCalibration {
 
  private:
   void clear_sums();
+  void add_sphere(TimeNs t_ns, const Eigen::Vector3d& field_ut, double dt_s);
+  void add_pairs(TimeNs t_ns, const Eigen::Vector3d& field_ut, double dt_s);
   MagCalibrationOptions opt_;
+  // gyro-aided: attitude phone -> a world-fixed frame, integrated from the gyro
+  struct Reading { TimeNs t_ns; Eigen::Vector3d m; Eigen::Matrix3d r, s; };
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  Eigen::Quaterniond q_ = Eigen::Quaterniond::Identity();
+  Eigen::Matrix3d s_ = Eigen::Matrix3d::Zero();  // integral of the attitude over time (s)
+  Eigen::Vector3d rate_ = Eigen::Vector3d::Zero();
+  TimeNs gyro_ns_ = -1;
+  bool gyro_live_ = false;
+  std::deque<Reading> readings_;
+  // weighted normal equations of the pairs in (b, gyro bias): sum w A^T A, w A^T y, w |y|^2, w
+  Mat6 pn_ = Mat6::Zero();
+  Vec6 pr_ = Vec6::Zero();
+  Eigen::Vector3d pair_b_ = Eigen::Vector3d::Zero();  // latest solution (linearisation point of h)
+  bool pair_solved_ = false;                          // a solution to gate pairs against
+  std::int64_t pairs_gated_ = 0;
+  Eigen::Vector3d gyro_bias_radps_ = Eigen::Vector3d::Zero();
+  double pyy_ = 0.0, pw_ = 0.0;
+  double pair_residual_ut_ = kNaN, bias_sigma_ut_ = kNaN;
   // weighted sums of m, m m^T, y = |m|^2, y m, y^2 (weights in s, forgotten with tau_s)
   double w_ = 0.0, sy_ = 0.0, syy_ = 0.0;
   Eigen::Vector3d sm_ = Eigen::Vector3d::Zero(), sym_ = Eigen::Vector3d::Zero();
@@ -80,6 +151,7 @@ class MagCalibration {
   bool have_last_ = false;
   TimeNs last_ns_ = 0;
   bool active_ = false;
+  TimeNs active_from_ns_ = -1;
   Eigen::Vector3d bias_ut_ = Eigen::Vector3d::Zero();
   double last_explained_ = kNaN, last_residual_ = kNaN;
   double radius_ut_ = kNaN, residual_ = kNaN, spread_ut2_ = 0.0;
