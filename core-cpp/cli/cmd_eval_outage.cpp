@@ -46,6 +46,7 @@ struct EvalOutageArgs {
   std::string format = "auto";
   double start_frac = 0.4, length_frac = 0.4, max_s = 300.0;
   double start_s = kNaNd, length_s = kNaNd;  // absolute (from the start of the GNSS span), override the fractions
+  std::vector<double> start_fracs;  // several windows per recording (a sweep), replaces start_frac
   std::string dem, graph;
   std::vector<std::string> nav;
   std::string out_dir;
@@ -176,9 +177,10 @@ Track replay(const std::vector<Sample>& samples, const fusion::NavigatorConfig& 
 
 WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std::shared_ptr<const terrain::Dem>& dem,
                     const std::shared_ptr<const route::WalkGraph>& graph,
-                    const std::shared_ptr<const gnss::EphemerisStore>& eph, const std::filesystem::path* out_dir) {
+                    const std::shared_ptr<const gnss::EphemerisStore>& eph, const std::filesystem::path* out_dir,
+                    const std::string& tag) {
   WalkResult r;
-  r.name = std::filesystem::path(path).filename().string();
+  r.name = std::filesystem::path(path).filename().string() + tag;
   // ---- read the recording ----
   std::vector<Sample> samples;
   std::vector<RefPoint> fixes, truth;
@@ -297,7 +299,7 @@ WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std:
 
   // ---- per-walk CSV and JSON for plotting ----
   if (out_dir) {
-    const std::filesystem::path stem = *out_dir / std::filesystem::path(path).stem();
+    const std::filesystem::path stem = *out_dir / (std::filesystem::path(path).stem().string() + tag);
     std::ofstream csv(stem.string() + ".csv");
     csv << "t_s,in_window,ref_e_m,ref_n_m,ref_sigma_m,fused_e_m,fused_n_m,fused_cov_ee_m2,fused_cov_en_m2,fused_cov_nn_m2,"
            "fused_mode,dr_e_m,dr_n_m,dr_cov_ee_m2,dr_cov_en_m2,dr_cov_nn_m2,fused_err_m,dr_err_m,fused_mahalanobis2\n";
@@ -348,9 +350,13 @@ int run_eval_outage(const EvalOutageArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   if (std::isfinite(a.start_s) != std::isfinite(a.length_s))
     throw std::invalid_argument("--start-s and --length-s go together");
-  if (!std::isfinite(a.start_s) &&
-      !(a.start_frac >= 0.0 && a.length_frac > 0.0 && a.start_frac + a.length_frac <= 1.0 && a.max_s > 0.0))
-    throw std::invalid_argument("need 0 <= --start-frac, 0 < --length-frac, their sum <= 1, --max-s > 0");
+  if (std::isfinite(a.start_s) && !a.start_fracs.empty())
+    throw std::invalid_argument("--start-fracs and --start-s exclude each other");
+  const std::vector<double> starts = a.start_fracs.empty() ? std::vector<double>{a.start_frac} : a.start_fracs;
+  for (double f : starts)
+    if (!std::isfinite(a.start_s) && !(f >= 0.0 && a.length_frac > 0.0 && f + a.length_frac <= 1.0 && a.max_s > 0.0))
+      throw std::invalid_argument("need 0 <= --start-frac (each of --start-fracs), 0 < --length-frac, their sum <= 1, "
+                                  "--max-s > 0 (start " + f3(f) + ")");
   std::shared_ptr<const terrain::Dem> dem;
   std::shared_ptr<const route::WalkGraph> graph;
   std::shared_ptr<const gnss::EphemerisStore> eph;
@@ -368,11 +374,16 @@ int run_eval_outage(const EvalOutageArgs& a) {
               a.logs.size(),
               std::isfinite(a.start_s)
                   ? ("from " + f1(a.start_s) + " s for " + f1(a.length_s) + " s of the GNSS span").c_str()
-                  : ("from " + f3(a.start_frac) + " of the GNSS span for " + f3(a.length_frac) + " of it, at most " +
-                     f1(a.max_s) + " s").c_str());
+                  : ("from " + (starts.size() == 1 ? f3(starts[0]) : std::to_string(starts.size()) + " starts " +
+                                f3(starts.front()) + ".." + f3(starts.back())) +
+                     " of the GNSS span for " + f3(a.length_frac) + " of it, at most " + f1(a.max_s) + " s").c_str());
   std::vector<WalkResult> results;
-  for (const std::string& log : a.logs) {
-    WalkResult r = evaluate(log, a, dem, graph, eph, out.empty() ? nullptr : &out);
+  for (const std::string& log : a.logs)
+  for (double start : starts) {
+    EvalOutageArgs b = a;
+    b.start_frac = start;
+    const std::string tag = a.start_fracs.empty() ? "" : "@" + f3(start).substr(0, 4);
+    WalkResult r = evaluate(log, b, dem, graph, eph, out.empty() ? nullptr : &out, tag);
     const double cov = r.epochs_in_window > 0 ? static_cast<double>(r.covered) / r.epochs_in_window : kNaNd;
     std::printf("%s: reference %s, GNSS span %.0f s, window %.0f-%.0f s (%d epochs; removed %lld Raw, %lld Fix rows)\n",
                 r.name.c_str(), r.reference.c_str(), r.span_s, r.w0_s, r.w1_s, r.epochs_in_window,
@@ -428,6 +439,10 @@ void register_eval_outage(CLI::App& app) {
   c->add_option("--start-frac", a->start_frac, "window start, fraction of the GNSS span")->capture_default_str();
   c->add_option("--length-frac", a->length_frac, "window length, fraction of the GNSS span")->capture_default_str();
   c->add_option("--max-s", a->max_s, "longest window, s")->capture_default_str();
+  c->add_option("--start-fracs", a->start_fracs,
+                 "several windows per recording (a sweep; comma-separated starts, fractions of the GNSS span): each "
+                 "(recording, window) is one walk of the summary line")
+      ->delimiter(',');
   c->add_option("--start-s", a->start_s, "window start, s from the start of the GNSS span (with --length-s)");
   c->add_option("--length-s", a->length_s, "window length, s (with --start-s)");
   c->add_option("--dem", a->dem, "DEM tile (.pdem) for the terrain engine")->check(CLI::ExistingFile);

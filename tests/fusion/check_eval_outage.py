@@ -99,6 +99,23 @@ def main(argv):
     r2 = run([pdnav, "eval-outage", log, "--nav", nav, "--mount", "chest", "--start-s", "100", "--length-s", "60", "--quiet"])
     if not re.search(r"window 100-160 s", r2.stdout) or not BAR.fullmatch(r2.stdout.rstrip("\n").split("\n")[-1]):
         failures.append(f"--start-s 100 --length-s 60 not honoured: {r2.stdout}")
+    # a sweep: one walk per (recording, window), the 0.4 window identical to the single run
+    sweep = os.path.join(scratch, "sweep")
+    r5 = run([pdnav, "eval-outage", log, "--nav", nav, "--dem", dem, "--graph", graph, "--out", sweep, "--mount", "chest",
+              "--start-fracs", "0.3,0.4", "--length-frac", "0.4", "--max-s", "300", "--quiet"])
+    m5 = BAR.fullmatch(r5.stdout.rstrip("\n").split("\n")[-1])
+    if not m5 or int(m5.group(5)) != 2:
+        failures.append(f"--start-fracs 0.3,0.4: not 2 walks: {r5.stdout[-300:]}")
+    if not os.path.isfile(os.path.join(sweep, "session@0.30.csv")) or not os.path.isfile(os.path.join(sweep, "session@0.40.json")):
+        failures.append("--start-fracs: per-window CSV/JSON missing")
+    else:
+        with open(os.path.join(sweep, "session@0.40.json")) as f:
+            j40 = json.load(f)
+        if abs(j40["outage_ratio"] - js["outage_ratio"]) > 1e-9 or abs(j40["coverage_68"] - js["coverage_68"]) > 1e-9:
+            failures.append("--start-fracs window 0.4 differs from --start-frac 0.4")
+    r6 = run([pdnav, "eval-outage", log, "--start-fracs", "0.3,0.7", "--length-frac", "0.4", "--quiet"], ok=False)
+    if r6.returncode == 0 or "start 0.700" not in (r6.stdout + r6.stderr):
+        failures.append(f"--start-fracs beyond the span: exit {r6.returncode}, {r6.stderr.strip()}")
     # bad input: a window outside the span; a log without fixes or truth
     r3 = run([pdnav, "eval-outage", log, "--start-s", "100", "--length-s", "100000", "--quiet"], ok=False)
     if r3.returncode == 0 or "not inside the GNSS span" not in (r3.stdout + r3.stderr):

@@ -12,9 +12,9 @@ set_tests_properties(fusion.eval_outage_session PROPERTIES FIXTURES_REQUIRED "te
 # Issue 28, compass deviation: tools/compass-deviation recovers a known one-cycle deviation
 # (hard iron) from a synthetic Sensor Logger walk and rejects bad input (check_compass_deviation.py);
 # on the real ETH walk the phone's compass error is one cycle (residual RMS <= 10 deg, a constant
-# leaves >= 18 deg: measured 8.9 / 21.5) while the PDR's heading after its online hard-iron
-# calibration is active (434 s) is within 12 deg RMS with or without a deviation (measured 8.0 with
-# a constant, 7.9 with one cycle; docs/fusion.md, eval-outage "The real walk").
+# leaves >= 18 deg: measured 8.9 / 21.5) while the PDR's heading, with its gyro-aided hard-iron
+# calibration active from 192 s, is within 12 deg RMS over the whole walk even as a constant
+# (measured 9.8; 14.8 with the sphere fit alone, active from 432 s; docs/pdr.md).
 add_test(NAME fusion.compass_deviation_synthetic
   COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/fusion/check_compass_deviation.py"
           "${PROJECT_SOURCE_DIR}/tools/compass-deviation" "${PROJECT_BINARY_DIR}/test-scratch/fusion-cli/compass-deviation")
@@ -24,7 +24,7 @@ set(_fusion_eth "${PDNAV_SHARED_DATA_DIR}/walk-ethz-sensorlogger/2023-03-17_15-5
 set(_fusion_dev_out "${PROJECT_BINARY_DIR}/test-scratch/fusion-cli/compass-deviation-eth")
 add_test(NAME fusion.compass_deviation_eth
   COMMAND sh -c "\"$0\" replay \"$1\" --engine dr --mount auto --out \"$2\" >/dev/null && \
-/usr/bin/python3 \"$3\" \"$1\" --dr \"$2\" --split-s 434 --out \"$2/deviation.png\""
+/usr/bin/python3 \"$3\" \"$1\" --dr \"$2\" --split-s 200 --out \"$2/deviation.png\""
           "$<TARGET_FILE:pdnav>" "${_fusion_eth}" "${_fusion_dev_out}" "${PROJECT_SOURCE_DIR}/tools/compass-deviation")
 set_tests_properties(fusion.compass_deviation_eth PROPERTIES LABELS "fusion;cli" TIMEOUT 120
-                     PASS_REGULAR_EXPRESSION "deviation: compass_pieces=4[0-9] compass_octants=[78] compass_rms_A_deg=(1[89]|2[0-9])\\.[0-9]+ compass_rms_ABC_deg=[0-9]\\.[0-9]+ .* pdr_after_pieces=[12][0-9] pdr_after_octants=[3-8] pdr_after_rms_A_deg=([0-9]|1[0-1])\\.[0-9]+ pdr_after_rms_ABC_deg=([0-9]|1[0-1])\\.[0-9]+ ")
+                     PASS_REGULAR_EXPRESSION "deviation: compass_pieces=4[0-9] compass_octants=[78] compass_rms_A_deg=(1[89]|2[0-9])\\.[0-9]+ compass_rms_ABC_deg=[0-9]\\.[0-9]+ .* pdr_pieces=4[0-9] pdr_octants=[78] pdr_rms_A_deg=([0-9]|1[01])\\.[0-9]+ pdr_rms_ABC_deg=([0-9]|1[01])\\.[0-9]+ .* pdr_after_pieces=[34][0-9] pdr_after_octants=[5-8] pdr_after_rms_A_deg=([0-9]|1[01])\\.[0-9]+ ")

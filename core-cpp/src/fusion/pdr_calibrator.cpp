@@ -51,7 +51,7 @@ struct RangeFit {
   bool ok = false;
   std::complex<double> gain = 0.0;
   double var_component = 0.0;  // of Re c and of Im c
-  double baseline_m = 0.0, rho = 0.0, span_s = 0.0;
+  double baseline_m = 0.0, rho = 0.0, span_s = 0.0, moving_s = 0.0;
 };
 }  // namespace
 
@@ -81,6 +81,10 @@ static RangeFit fit_range(It b, It e, const PdrCalibrationOptions& opt) {
   }
   f.baseline_m = std::sqrt(spread / n);
   f.span_s = static_cast<double>(std::prev(e)->t_ns - b->t_ns) * 1e-9;
+  // the time the PDR track moved between epochs: epochs of a walker standing still repeat one
+  // PDR position and say nothing about the scale or the bias
+  for (It x = std::next(b); x != e; ++x)
+    if (x->p != std::prev(x)->p) f.moving_s += static_cast<double>(x->t_ns - std::prev(x)->t_ns) * 1e-9;
   if (!(spp > 0.0)) return f;
   f.gain = spg / spp;
   // variance factor from the residuals (2 n observations, 4 parameters), never below 1:
@@ -102,7 +106,7 @@ static RangeFit fit_range(It b, It e, const PdrCalibrationOptions& opt) {
   // (Bayley & Hammersley 1946), so a run of smoothed fixes is never counted as many.
   f.rho = r0 > 0.0 ? std::clamp(r1 / r0, 0.0, 0.999) : 0.0;
   const double n_eff_ar = opt.residual_correlation ? n * (1.0 - f.rho) / (1.0 + f.rho) : n;
-  const double n_eff = std::clamp(std::min(f.span_s / opt.correlation_time_s + 1.0, n_eff_ar), 1.0, n);
+  const double n_eff = std::clamp(std::min(f.moving_s / opt.correlation_time_s + 1.0, n_eff_ar), 1.0, n);
   f.var_component = var_factor / spp * (n / n_eff);
   f.ok = true;
   return f;

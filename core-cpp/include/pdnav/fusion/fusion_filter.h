@@ -24,7 +24,9 @@ namespace pdnav::fusion {
 
 struct FusionFilterOptions {
   // --- prediction ---
-  double initial_scale_sigma = 0.10;               // APT height model 1-sigma 10 % (Zhu 2015, Sec. V-C)
+  /// Step-length scale of an unknown walker: 15 % (the uncalibrated length ratio over the real
+  /// sets spans 0.75-1.01; APT's height model claims 10 %, Zhu 2015 Sec. V-C); = DeadReckoningOptions.
+  double initial_scale_sigma = 0.15;
   double initial_heading_bias_sigma_rad = 10.0 * kDegToRad;  // rotation-vector heading accuracy class
   /// Random walk of the residual heading bias (magnetic disturbances, gyro drift): (2 deg)^2 per minute.
   double heading_bias_rw_rad2ps = (2.0 * kDegToRad) * (2.0 * kDegToRad) / 60.0;

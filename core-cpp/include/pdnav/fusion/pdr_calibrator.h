@@ -22,15 +22,15 @@ struct PdrCalibrationOptions {
   double window_s = 300.0;            // Walker 2019 Sec. 3: sliding window (5 min here)
   double min_baseline_m = 20.0;       // RMS spread of the PDR track in the window before publishing
   int min_epochs = 20;                // GNSS epochs in the window before publishing
-  double correlation_time_s = 10.0;   // GNSS error correlation (multipath): N_eff <= span / this
+  double correlation_time_s = 10.0;   // GNSS error correlation (multipath): N_eff <= time moving / this
   bool residual_correlation = true;   // N_eff also <= the AR(1) value of the residuals (pdr_calibrator.cpp)
   bool check_bias_drift = true;       // fit the two halves of the window: how far the bias moved
   bool independent_heading = true;    // false: one publication test on both sigmas (before issue 28)
-  /// Published when it knows the scale and the heading bias at least twice as well as the
-  /// fused filter's prior (10 %, 10 deg: FusionFilterOptions); the filter then carries the fit's
-  /// own sigmas, so a less certain calibration is used with its honest uncertainty.
-  double max_scale_sigma = 0.05;
-  double max_heading_bias_sigma_rad = 5.0 * kDegToRad;
+  /// Published when it knows the scale and the heading bias better than the fused filter's
+  /// prior (15 %, 10 deg: FusionFilterOptions); the filter then carries the fit's own sigmas,
+  /// so a less certain calibration is used with its honest uncertainty.
+  double max_scale_sigma = 0.15;
+  double max_heading_bias_sigma_rad = 10.0 * kDegToRad;
   double prior_heading_bias_sigma_rad = 10.0 * kDegToRad;  // = FusionFilterOptions::initial_heading_bias_sigma_rad
   double min_scale = 0.5, max_scale = 1.8;  // a fit outside is not a calibration (wrong data)
   std::size_t max_steps_kept = 4096;  // bound on the step history (memory)
