@@ -34,7 +34,9 @@ void MagCalibration::add_gyro(TimeNs t_ns, const Eigen::Vector3d& rate_radps) {
     if (t_ns <= gyro_ns_) return;  // duplicate or backwards
     const double dt_s = ns_to_s(t_ns - gyro_ns_);
     if (dt_s > opt_.max_gyro_gap_s) {
-      readings_.clear();  // the attitude over the gap is unknown: no pair across it
+      // the attitude over the gap is unknown: no pair across it
+      readings_.clear();
+      gyro_history_.clear();
     } else {
       const Eigen::Matrix3d r0 = q_.toRotationMatrix();
       q_ = (q_ * exp_rotation(0.5 * (rate_ + rate_radps) * dt_s)).normalized();  // trapezoid
@@ -43,6 +45,23 @@ void MagCalibration::add_gyro(TimeNs t_ns, const Eigen::Vector3d& rate_radps) {
   }
   rate_ = rate_radps;
   gyro_ns_ = t_ns;
+  gyro_history_.push_back({t_ns, q_, s_, rate_radps});
+  while (gyro_history_.size() > 2 && gyro_history_.front().t_ns < t_ns - s_to_ns(opt_.gyro_history_s))
+    gyro_history_.pop_front();
+}
+
+bool MagCalibration::attitude_at(TimeNs t_ns, Eigen::Matrix3d* r, Eigen::Matrix3d* s) const {
+  if (gyro_history_.empty()) return false;
+  // the last gyro state at or before t_ns, carried to t_ns with its rate (at most max_gyro_gap_s)
+  auto it = std::upper_bound(gyro_history_.begin(), gyro_history_.end(), t_ns,
+                             [](TimeNs v, const Attitude& a) { return v < a.t_ns; });
+  if (it == gyro_history_.begin()) return false;  // older than the history
+  const Attitude& a = *(it - 1);
+  const double ahead_s = ns_to_s(t_ns - a.t_ns);
+  if (ahead_s > opt_.max_gyro_gap_s) return false;
+  *r = (a.q * exp_rotation(a.rate * ahead_s)).normalized().toRotationMatrix();
+  *s = a.s + ahead_s * 0.5 * (a.q.toRotationMatrix() + *r);
+  return true;
 }
 
 void MagCalibration::add(TimeNs t_ns, const Eigen::Vector3d& field_ut) {
@@ -51,23 +70,28 @@ void MagCalibration::add(TimeNs t_ns, const Eigen::Vector3d& field_ut) {
   const double dt_s = have_last_ ? ns_to_s(t_ns - last_ns_) : opt_.sample_interval_s;
   have_last_ = true;
   last_ns_ = t_ns;
-  const bool live = opt_.gyro_aided && gyro_ns_ >= 0 && std::abs(ns_to_s(t_ns - gyro_ns_)) <= opt_.max_gyro_gap_s;
+  // a gyro is live when one of its samples is within the history span of this reading, before
+  // or after it (a batched stream may run ahead of the magnetometer's)
+  const bool live = opt_.gyro_aided && gyro_ns_ >= 0 &&
+                    std::abs(ns_to_s(t_ns - gyro_ns_)) <= opt_.gyro_history_s;
   if (live != gyro_live_) {  // the other fit starts afresh (the bias in use stays)
     clear_sums();
     readings_.clear();
     gyro_live_ = live;
   }
-  if (live) add_pairs(t_ns, field_ut, dt_s);
-  else add_sphere(t_ns, field_ut, dt_s);
+  if (!live) {
+    add_sphere(t_ns, field_ut, dt_s);
+    return;
+  }
+  Eigen::Matrix3d r, s;
+  if (!attitude_at(t_ns, &r, &s)) return;  // no attitude at this reading's time: not paired
+  add_pairs(t_ns, field_ut, dt_s, r, s);
 }
 
-void MagCalibration::add_pairs(TimeNs t_ns, const Eigen::Vector3d& m, double dt_s) {
+void MagCalibration::add_pairs(TimeNs t_ns, const Eigen::Vector3d& m, double dt_s, const Eigen::Matrix3d& r,
+                               const Eigen::Matrix3d& s_now) {
   const double decay = std::exp(-dt_s / opt_.tau_s);
   pn_ *= decay, pr_ *= decay, pyy_ *= decay, pw_ *= decay;
-  // the attitude at t_ns: the last gyro sample's, carried to t_ns with its rate
-  const double ahead_s = ns_to_s(t_ns - gyro_ns_);
-  const Eigen::Matrix3d r = (q_ * exp_rotation(rate_ * ahead_s)).normalized().toRotationMatrix();
-  const Eigen::Matrix3d s_now = s_ + ahead_s * r;
   const Eigen::Vector3d rm = r * m;
   int lags = 0;
   for (double lag = 1.0; lag <= opt_.max_lag_s + 1e-9; lag *= 2.0) ++lags;

@@ -40,6 +40,10 @@ struct MagCalibrationOptions {
   double max_lag_s = 8.0;            // pairs at lags 1, 2, 4, 8 s (the world field at two places
                                      // a few metres apart; gyro drift over 8 s is < 0.1 deg)
   double max_gyro_gap_s = 0.2;       // a longer gap breaks the attitude: pairs restart
+  // the gyro attitude is kept this long, so a magnetometer reading that arrives late (sensor
+  // batching delivers each sensor's FIFO in turn) still finds the attitude at its own time; the
+  // gyro-aided fit is in use while a gyro sample is at most this far from the reading
+  double gyro_history_s = 5.0;
   double prior_bias_ut = 30.0;       // prior 1-sigma of b (phone hard iron left after calibration)
   double prior_gyro_bias_radps = 0.1 * kDegToRad;  // residual bias of a calibrated MEMS gyro (as HeadingFusionOptions)
   double pair_noise_ut = 1.0;        // nominal 1-sigma of one pair's residual (two readings' noise)
@@ -123,16 +127,22 @@ class MagCalibration {
  private:
   void clear_sums();
   void add_sphere(TimeNs t_ns, const Eigen::Vector3d& field_ut, double dt_s);
-  void add_pairs(TimeNs t_ns, const Eigen::Vector3d& field_ut, double dt_s);
+  void add_pairs(TimeNs t_ns, const Eigen::Vector3d& field_ut, double dt_s, const Eigen::Matrix3d& r,
+                 const Eigen::Matrix3d& s);
   MagCalibrationOptions opt_;
   // gyro-aided: attitude phone -> a world-fixed frame, integrated from the gyro
   struct Reading { TimeNs t_ns; Eigen::Vector3d m; Eigen::Matrix3d r, s; };
   using Mat6 = Eigen::Matrix<double, 6, 6>;
   using Vec6 = Eigen::Matrix<double, 6, 1>;
+  struct Attitude { TimeNs t_ns; Eigen::Quaterniond q; Eigen::Matrix3d s; Eigen::Vector3d rate; };
+  /// The attitude (and its time integral) at t_ns from the gyro history; false when no gyro
+  /// sample is within max_gyro_gap_s of it on an unbroken stretch.
+  bool attitude_at(TimeNs t_ns, Eigen::Matrix3d* r, Eigen::Matrix3d* s) const;
   Eigen::Quaterniond q_ = Eigen::Quaterniond::Identity();
   Eigen::Matrix3d s_ = Eigen::Matrix3d::Zero();  // integral of the attitude over time (s)
   Eigen::Vector3d rate_ = Eigen::Vector3d::Zero();
   TimeNs gyro_ns_ = -1;
+  std::deque<Attitude> gyro_history_;  // the last gyro_history_s of attitudes (a gap clears it)
   bool gyro_live_ = false;
   std::deque<Reading> readings_;
   // weighted normal equations of the pairs in (b, gyro bias): sum w A^T A, w A^T y, w |y|^2, w
