@@ -12,7 +12,8 @@
       fusion.png  a fused replay: the track coloured by the engine shown, and the horizontal
                   error and predicted 1-sigma vs time with every span without GNSS shaded
   tools/plot.py outage DIR [--title T] [--out DIR]
-      <walk>_outage.png for every <walk>.csv of `pdnav eval-outage --out DIR`: the reference
+      <walk>_outage.png for every <walk>.csv of `pdnav eval-outage --out DIR` (and
+      outage_summary.png when there are several walks or --start-fracs windows): the reference
                   (withheld fixes or truth), the fused track and dead reckoning from the last fix,
                   the withheld window highlighted; below, the error of both and the fused
                   1-sigma (semi-major) and 68 % radius vs time, the window shaded
@@ -307,6 +308,7 @@ def plot_outage(args):
         sys.exit(f"plot: {args.dir}: no per-walk CSV (run pdnav eval-outage --out {args.dir})")
     out = args.out or args.dir
     os.makedirs(out, exist_ok=True)
+    metas = []
     for path in paths:
         rows = read_csv(path)
         stem = os.path.splitext(os.path.basename(path))[0]
@@ -314,6 +316,7 @@ def plot_outage(args):
         if os.path.exists(os.path.join(args.dir, stem + ".json")):
             with open(os.path.join(args.dir, stem + ".json")) as f:
                 meta = json.load(f)
+            metas.append((stem, meta))
         t = col(rows, "t_s")
         win = col(rows, "in_window") > 0.5
         re_, rn = col(rows, "ref_e_m"), col(rows, "ref_n_m")
@@ -376,6 +379,46 @@ def plot_outage(args):
         fig.savefig(p, dpi=110)
         plt.close(fig)
         print(f"plot: wrote {p}")
+    if len(metas) >= 2:
+        plot_outage_summary(metas, out, args.title)
+
+
+def plot_outage_summary(metas, out, title):
+    """Several walks (or windows of one walk, --start-fracs): ratio, RMS and coverage per walk
+    against the bars, the summary line's median ratio and pooled coverage drawn across."""
+    names = [m[0] for m in metas]
+    ratio = np.array([m[1].get("outage_ratio", np.nan) for m in metas], dtype=float)
+    cov = np.array([m[1].get("coverage_68", np.nan) for m in metas], dtype=float)
+    n_ep = np.array([m[1].get("epochs_in_window", 0) for m in metas], dtype=float)
+    f_rms = np.array([m[1].get("fused", {}).get("rms_m", np.nan) for m in metas], dtype=float)
+    d_rms = np.array([m[1].get("dr", {}).get("rms_m", np.nan) for m in metas], dtype=float)
+    ok = np.isfinite(cov) & (n_ep > 0)
+    pooled = float(np.sum(cov[ok] * n_ep[ok]) / np.sum(n_ep[ok])) if ok.any() else float("nan")
+    x = np.arange(len(names))
+    fig, (a1, a2, a3) = plt.subplots(3, 1, figsize=(max(7, 0.9 * len(names) + 3), 9), sharex=True)
+    a1.bar(x, ratio, color="tab:blue")
+    a1.axhline(0.5, color="k", ls="--", lw=0.8, label="bar 0.5")
+    a1.axhline(np.nanmedian(ratio), color="tab:red", lw=1.0, label=f"median {np.nanmedian(ratio):.3f}")
+    a1.set_ylabel("fused RMS / DR RMS")
+    a1.legend(fontsize=8)
+    a2.bar(x - 0.2, f_rms, 0.4, color="tab:blue", label="fused")
+    a2.bar(x + 0.2, d_rms, 0.4, color="tab:red", label="dead reckoning from the last fix")
+    a2.set_ylabel("RMS in the window, m")
+    a2.legend(fontsize=8)
+    a3.bar(x, cov, color="tab:green")
+    a3.axhspan(0.5, 0.9, color="0.9", label="bar 0.5-0.9", zorder=0)
+    a3.axhline(pooled, color="tab:red", lw=1.0, label=f"pooled {pooled:.3f}")
+    a3.set_ylim(0, 1.05)
+    a3.set_ylabel("inside the 68 % region")
+    a3.legend(fontsize=8)
+    a3.set_xticks(x)
+    a3.set_xticklabels(names, rotation=30, ha="right", fontsize=8)
+    a1.set_title(title or f"eval-outage over {len(names)} walks / windows", fontsize=10)
+    fig.tight_layout()
+    p = os.path.join(out, "outage_summary.png")
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    print(f"plot: wrote {p}")
 
 
 def plot_gnss(args):
