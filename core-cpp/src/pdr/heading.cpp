@@ -7,6 +7,8 @@
 
 #include <Eigen/Geometry>
 
+#include "rotation_increment.h"
+
 namespace pdnav::pdr {
 
 Eigen::Vector3d forward_axis(Mount mount) {
@@ -157,9 +159,7 @@ void GyroTurnTracker::feed(const GyroSample& s) {
     const Eigen::Vector3d w = 0.5 * (s.rate_radps + gyro_last_);
     if (tilt_ok_) {
       const Eigen::Vector3d before = tilt_up_;
-      const double angle = w.norm() * dt;
-      if (angle > 0.0)
-        attitude_ = (attitude_ * Eigen::Quaterniond(Eigen::AngleAxisd(angle, w.normalized()))).normalized();
+      if (w.norm() * dt > 0.0) attitude_ = (attitude_ * detail::rotation_increment(w, dt)).normalized();
       tilt_up_ = attitude_.conjugate() * Eigen::Vector3d::UnitZ();
       yaw_rad_ += w.dot(0.5 * (before + tilt_up_)) * dt;
       update_axis_yaw();

@@ -8,6 +8,8 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
+#include "rotation_increment.h"
+
 namespace pdnav::pdr {
 
 void MagCalibration::clear_sums() {
@@ -20,13 +22,9 @@ void MagCalibration::clear_sums() {
   pyy_ = pw_ = 0.0;
 }
 
-namespace {
-Eigen::Quaterniond exp_rotation(const Eigen::Vector3d& v_rad) {
-  const double a = v_rad.norm();
-  if (!(a > 1e-12)) return Eigen::Quaterniond::Identity();
-  return Eigen::Quaterniond(Eigen::AngleAxisd(a, v_rad / a));
+MagCalibration::MagCalibration(const MagCalibrationOptions& options) : opt_(options) {
+  for (double lag = 1.0; lag <= opt_.max_lag_s + 1e-9; lag *= 2.0) lags_ns_.push_back(s_to_ns(lag));
 }
-}  // namespace
 
 void MagCalibration::add_gyro(TimeNs t_ns, const Eigen::Vector3d& rate_radps) {
   if (!opt_.enabled || !opt_.gyro_aided || !rate_radps.allFinite()) return;
@@ -38,14 +36,15 @@ void MagCalibration::add_gyro(TimeNs t_ns, const Eigen::Vector3d& rate_radps) {
       readings_.clear();
       gyro_history_.clear();
     } else {
-      const Eigen::Matrix3d r0 = q_.toRotationMatrix();
-      q_ = (q_ * exp_rotation(0.5 * (rate_ + rate_radps) * dt_s)).normalized();  // trapezoid
-      s_ += 0.5 * dt_s * (r0 + q_.toRotationMatrix());
+      const Eigen::Matrix3d r0 = r_;
+      q_ = (q_ * detail::rotation_increment(0.5 * (rate_ + rate_radps), dt_s)).normalized();  // trapezoid
+      r_ = q_.toRotationMatrix();
+      s_ += 0.5 * dt_s * (r0 + r_);
     }
   }
   rate_ = rate_radps;
   gyro_ns_ = t_ns;
-  gyro_history_.push_back({t_ns, q_, s_, rate_radps});
+  gyro_history_.push_back({t_ns, q_, r_, s_, rate_radps});
   while (gyro_history_.size() > 2 && gyro_history_.front().t_ns < t_ns - s_to_ns(opt_.gyro_history_s))
     gyro_history_.pop_front();
 }
@@ -59,8 +58,8 @@ bool MagCalibration::attitude_at(TimeNs t_ns, Eigen::Matrix3d* r, Eigen::Matrix3
   const Attitude& a = *(it - 1);
   const double ahead_s = ns_to_s(t_ns - a.t_ns);
   if (ahead_s > opt_.max_gyro_gap_s) return false;
-  *r = (a.q * exp_rotation(a.rate * ahead_s)).normalized().toRotationMatrix();
-  *s = a.s + ahead_s * 0.5 * (a.q.toRotationMatrix() + *r);
+  *r = (a.q * detail::rotation_increment(a.rate, ahead_s)).normalized().toRotationMatrix();
+  *s = a.s + ahead_s * 0.5 * (a.r + *r);
   return true;
 }
 
@@ -93,12 +92,10 @@ void MagCalibration::add_pairs(TimeNs t_ns, const Eigen::Vector3d& m, double dt_
   const double decay = std::exp(-dt_s / opt_.tau_s);
   pn_ *= decay, pr_ *= decay, pyy_ *= decay, pw_ *= decay;
   const Eigen::Vector3d rm = r * m;
-  int lags = 0;
-  for (double lag = 1.0; lag <= opt_.max_lag_s + 1e-9; lag *= 2.0) ++lags;
-  const double w = std::min(dt_s, opt_.max_weight_s) / std::max(1, lags);
+  const double w = std::min(dt_s, opt_.max_weight_s) / static_cast<double>(std::max<std::size_t>(1, lags_ns_.size()));
   const double min_cos = std::cos(opt_.min_pair_rotation_rad);
-  for (double lag = 1.0; lag <= opt_.max_lag_s + 1e-9; lag *= 2.0) {
-    const TimeNs target = t_ns - s_to_ns(lag);
+  for (const TimeNs lag_ns : lags_ns_) {
+    const TimeNs target = t_ns - lag_ns;
     auto it = std::lower_bound(readings_.begin(), readings_.end(), target,
                                [](const Reading& x, TimeNs v) { return x.t_ns < v; });
     if (it == readings_.end() || (it != readings_.begin() && target - (it - 1)->t_ns < it->t_ns - target)) {

@@ -2,6 +2,7 @@
 #pragma once
 #include <cstdint>
 #include <deque>
+#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -89,7 +90,7 @@ struct MagCalibrationOptions {
 /// Streaming hard-iron sphere fit. Deterministic; time as int64 ns.
 class MagCalibration {
  public:
-  explicit MagCalibration(const MagCalibrationOptions& options = {}) : opt_(options) {}
+  explicit MagCalibration(const MagCalibrationOptions& options = {});
   /// One reading (phone axes, uT). Non-finite readings and backwards time are ignored.
   void add(TimeNs t_ns, const Eigen::Vector3d& field_ut);
   /// One calibrated gyroscope sample (phone axes, rad/s): the attitude of the gyro-aided fit.
@@ -134,12 +135,14 @@ class MagCalibration {
   struct Reading { TimeNs t_ns; Eigen::Vector3d m; Eigen::Matrix3d r, s; };
   using Mat6 = Eigen::Matrix<double, 6, 6>;
   using Vec6 = Eigen::Matrix<double, 6, 1>;
-  struct Attitude { TimeNs t_ns; Eigen::Quaterniond q; Eigen::Matrix3d s; Eigen::Vector3d rate; };
+  struct Attitude { TimeNs t_ns; Eigen::Quaterniond q; Eigen::Matrix3d r, s; Eigen::Vector3d rate; };
   /// The attitude (and its time integral) at t_ns from the gyro history; false when no gyro
   /// sample is within max_gyro_gap_s of it on an unbroken stretch.
   bool attitude_at(TimeNs t_ns, Eigen::Matrix3d* r, Eigen::Matrix3d* s) const;
   Eigen::Quaterniond q_ = Eigen::Quaterniond::Identity();
+  Eigen::Matrix3d r_ = Eigen::Matrix3d::Identity();  // q_ as a matrix
   Eigen::Matrix3d s_ = Eigen::Matrix3d::Zero();  // integral of the attitude over time (s)
+  std::vector<TimeNs> lags_ns_;                  // pair lags: 1, 2, 4, ... s up to max_lag_s
   Eigen::Vector3d rate_ = Eigen::Vector3d::Zero();
   TimeNs gyro_ns_ = -1;
   std::deque<Attitude> gyro_history_;  // the last gyro_history_s of attitudes (a gap clears it)
