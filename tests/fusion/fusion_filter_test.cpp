@@ -190,6 +190,41 @@ TEST(FusionFilter, HeadingBiasVarianceAfterAWindowFollowsTheGaussMarkovModel) {
   EXPECT_NEAR(g.heading_bias_var_after_window(fit, 300.0), fit, 1e-12);
 }
 
+// Issue 28: the residual step-scale error is a Gauss-Markov process with the unknown walker's
+// sigma: a calibration's knowledge of the scale fades back to the prior (a walker's pace and
+// stride change over minutes), at the rate the window fit's own variance predicts.
+TEST(FusionFilter, ScaleErrorFadesBackToThePriorAsAGaussMarkovProcess) {
+  FusionFilter f;  // scale_tau_s 300 s, initial_scale_sigma 0.15
+  const double tau = f.options().scale_tau_s, s2 = std::pow(f.options().initial_scale_sigma, 2);
+  ASSERT_GT(tau, 0.0);
+  f.initialize(Eigen::Vector2d::Zero(), 3.0, 0);
+  const double fit = 0.02 * 0.02;
+  EXPECT_NEAR(f.scale_var_after_window(fit, 1e-6), fit, 1e-9);
+  EXPECT_NEAR(f.scale_var_after_window(fit, tau), fit + 0.4715 * s2, 1e-3 * s2);  // g(1) = 0.4715
+  f.set_residual_uncertainty(1e-4, fit);
+  const double rw = f.options().scale_rw_1ps;
+  f.advance_to(static_cast<TimeNs>(tau * 1e9 / 2));  // in two steps: the same as one
+  f.advance_to(static_cast<TimeNs>(tau * 1e9));      // one correlation time: phi = 1/e
+  const double phi2 = std::exp(-2.0);
+  EXPECT_NEAR(f.scale_error_var(), phi2 * fit + (1.0 - phi2) * s2, 1e-9);
+  f.advance_to(static_cast<TimeNs>(20.0 * tau * 1e9));  // long after: the prior
+  EXPECT_NEAR(f.scale_error_var(), s2, 1e-9);
+  // an uncalibrated filter stays at the prior: it never claims less than it started with
+  FusionFilter g;
+  g.initialize(Eigen::Vector2d::Zero(), 3.0, 0);
+  g.advance_to(static_cast<TimeNs>(600e9));
+  EXPECT_NEAR(g.scale_error_var(), s2, 1e-12);
+  // scale_tau_s = 0: the random walk alone (before this model)
+  FusionFilterOptions rw_only;
+  rw_only.scale_tau_s = 0.0;
+  FusionFilter h(rw_only);
+  h.initialize(Eigen::Vector2d::Zero(), 3.0, 0);
+  h.set_residual_uncertainty(1e-4, fit);
+  h.advance_to(static_cast<TimeNs>(tau * 1e9));
+  EXPECT_NEAR(h.scale_error_var(), fit + rw * tau, 1e-12);
+  EXPECT_NEAR(h.scale_var_after_window(fit, tau), fit, 1e-12);
+}
+
 TEST(FusionFilter, Chi2QuantileMatchesTables) {
   EXPECT_NEAR(chi2_quantile(2, 0.99), 9.21, 0.15);
   EXPECT_NEAR(chi2_quantile(8, 0.99), 20.09, 0.2);

@@ -69,17 +69,22 @@ void FusionFilter::advance_to(TimeNs t_ns) {
     p_(1, 1) += opt_.undetected_motion_q_m2ps * dt;
   }
   const double dt_all = static_cast<double>(t_ns - t_ns_) * 1e-9;
-  if (opt_.heading_bias_tau_s > 0.0 && heading_stationary_var_ > 0.0) {
-    // first-order Gauss-Markov heading bias: decays towards 0, variance towards the stated one
-    const double phi = std::exp(-dt_all / opt_.heading_bias_tau_s);
-    x_(2) *= phi;
-    for (int i = 0; i < 6; ++i)
-      if (i != 2) p_(2, i) *= phi, p_(i, 2) *= phi;
-    p_(2, 2) = phi * phi * p_(2, 2) + heading_stationary_var_ * (1.0 - phi * phi);
-  }
+  // first-order Gauss-Markov residual states: decay towards 0, variance towards the stationary one
+  if (opt_.heading_bias_tau_s > 0.0 && heading_stationary_var_ > 0.0)
+    gauss_markov_step(2, dt_all, opt_.heading_bias_tau_s, heading_stationary_var_);
+  if (opt_.scale_tau_s > 0.0)
+    gauss_markov_step(3, dt_all, opt_.scale_tau_s, opt_.initial_scale_sigma * opt_.initial_scale_sigma);
   p_(2, 2) += opt_.heading_bias_rw_rad2ps * dt_all;
-  p_(3, 3) += opt_.scale_rw_1ps * dt_all;
+  if (!(opt_.scale_tau_s > 0.0)) p_(3, 3) += opt_.scale_rw_1ps * dt_all;  // the GM model replaces it
   t_ns_ = t_ns;
+}
+
+void FusionFilter::gauss_markov_step(int k, double dt_s, double tau_s, double stationary_var) {
+  const double phi = std::exp(-dt_s / tau_s);
+  x_(k) *= phi;
+  for (int i = 0; i < 6; ++i)
+    if (i != k) p_(k, i) *= phi, p_(i, k) *= phi;
+  p_(k, k) = phi * phi * p_(k, k) + stationary_var * (1.0 - phi * phi);
 }
 
 void FusionFilter::predict(const PdrStep& s) {
@@ -127,12 +132,26 @@ void FusionFilter::set_residual_uncertainty(double var_b, double var_s) {
   p_(3, 3) = std::max(var_s, 1e-8);
 }
 
-double FusionFilter::heading_bias_var_after_window(double fit_var, double window_s) const {
-  if (!(opt_.heading_bias_tau_s > 0.0) || !(heading_stationary_var_ > 0.0) || !(window_s > 0.0)) return fit_var;
-  const double u = window_s / opt_.heading_bias_tau_s;
+namespace {
+/// Variance of a first-order Gauss-Markov process (stationary variance var, correlation time
+/// tau_s) now, about its mean over the window_s before: var g(W / tau) with
+/// g(u) = 1 - 2 (1 - e^-u) / u + 2 (u - 1 + e^-u) / u^2 (the autocovariance integrated over the window).
+double gm_var_about_window_mean(double var, double window_s, double tau_s) {
+  const double u = window_s / tau_s;
   const double eu = std::exp(-u);
   const double g = u < 1e-3 ? u / 3.0 : 1.0 - 2.0 * (1.0 - eu) / u + 2.0 * (u - 1.0 + eu) / (u * u);
-  return fit_var + std::clamp(g, 0.0, 1.0) * heading_stationary_var_;
+  return std::clamp(g, 0.0, 1.0) * var;
+}
+}  // namespace
+
+double FusionFilter::heading_bias_var_after_window(double fit_var, double window_s) const {
+  if (!(opt_.heading_bias_tau_s > 0.0) || !(heading_stationary_var_ > 0.0) || !(window_s > 0.0)) return fit_var;
+  return fit_var + gm_var_about_window_mean(heading_stationary_var_, window_s, opt_.heading_bias_tau_s);
+}
+
+double FusionFilter::scale_var_after_window(double fit_var, double window_s) const {
+  if (!(opt_.scale_tau_s > 0.0) || !(window_s > 0.0)) return fit_var;
+  return fit_var + gm_var_about_window_mean(opt_.initial_scale_sigma * opt_.initial_scale_sigma, window_s, opt_.scale_tau_s);
 }
 
 void FusionFilter::after(TimeNs t_ns, Eigen::Vector2d* d, double* var) const {

@@ -58,6 +58,7 @@ FusionOptions fusion_options_before_issue28() {
   o.aid_var_scale = 4.0;
   o.filter.consider_pdr_states_on_position = false;
   o.filter.heading_bias_tau_s = 0.0;
+  o.filter.scale_tau_s = 0.0;
   o.calibration.max_scale_sigma = 0.03;
   o.calibration.max_heading_bias_sigma_rad = 4.0 * kDegToRad;
   o.calibration.residual_correlation = false;
@@ -482,7 +483,9 @@ struct Navigator::Impl {
       // the fit is the bias averaged over its window; what the filter carries is the bias now
       const double var_b = ff.heading_bias_var_after_window(p.heading_bias_sigma_rad * p.heading_bias_sigma_rad, p.span_s);
       applied.heading_bias_sigma_rad = std::sqrt(var_b);
-      ff.set_residual_uncertainty(var_b, p.scale_sigma * p.scale_sigma);
+      const double var_s = ff.scale_var_after_window(p.scale_sigma * p.scale_sigma, p.span_s);
+      applied.scale_sigma = std::sqrt(var_s);
+      ff.set_residual_uncertainty(var_b, var_s);
     }
   }
 

@@ -30,8 +30,16 @@ struct FusionFilterOptions {
   double initial_heading_bias_sigma_rad = 10.0 * kDegToRad;  // rotation-vector heading accuracy class
   /// Random walk of the residual heading bias (magnetic disturbances, gyro drift): (2 deg)^2 per minute.
   double heading_bias_rw_rad2ps = (2.0 * kDegToRad) * (2.0 * kDegToRad) / 60.0;
-  /// Random walk of the residual step scale (pace changes): (1 %)^2 per minute.
+  /// Random walk of the residual step scale (pace changes): (1 %)^2 per minute; only with
+  /// scale_tau_s = 0 (the Gauss-Markov model below replaces it).
   double scale_rw_1ps = 1e-4 / 60.0;
+  /// The residual step-scale error is a first-order Gauss-Markov process too, with stationary
+  /// sigma initial_scale_sigma (the scale of an unknown walker) and this correlation time (the
+  /// calibration window): what a calibration learned about the scale fades back to the prior over
+  /// minutes, as a walker's pace, stride and ground change (Gelb 1974, Sec. 3.8; measured on the
+  /// ETH walk: fitted scale 1.22 / 1.40 / 1.24 over consecutive 2-5 min spans, docs/fusion.md).
+  /// 0 = the random walk alone (the model before this option).
+  double scale_tau_s = 300.0;
   /// The PDR's stated heading 1-sigma (PdrStep::heading_sigma_rad: compass / rotation vector
   /// accuracy) is the sigma of a slowly varying error (magnetic disturbances along the way, gyro
   /// drift), not of independent per-step noise: the heading bias state is a first-order
@@ -93,6 +101,9 @@ class FusionFilter {
   /// by sigma^2 g(W / tau), g(u) = 1 - 2 (1 - e^-u) / u + 2 (u - 1 + e^-u) / u^2 (the
   /// exponential autocovariance integrated over the window). Without the model: fit_var_rad2.
   double heading_bias_var_after_window(double fit_var_rad2, double window_s) const;
+  /// The same for the step scale (scale_tau_s, initial_scale_sigma): the variance of the scale
+  /// error now given a fit of its window average with variance fit_var.
+  double scale_var_after_window(double fit_var, double window_s) const;
   /// Position measurement at t_ns (possibly before the last step: the steps after it are
   /// taken off the prediction) through the windowed gate. `R` is its 2x2 covariance.
   /// `floor_fraction` >= 0 replaces options().position_floor_fraction for this update (and the
@@ -117,6 +128,7 @@ class FusionFilter {
   Eigen::Matrix2d position_cov_m2() const { return p_.topLeftCorner<2, 2>(); }
   double heading_bias_rad() const { return x_(2); }
   double scale_error() const { return x_(3); }
+  double scale_error_var() const { return p_(3, 3); }
   TimeNs t_ns() const { return t_ns_; }
   TimeNs last_accepted_ns() const { return last_accept_ns_; }
   TimeNs clone_t_ns() const { return clone_ok_ ? clone_t_ns_ : -1; }
@@ -136,6 +148,8 @@ class FusionFilter {
   void apply_position(const Eigen::Vector2d& z, const Eigen::Matrix2d& r);
   bool agree(const std::vector<Held>& h, Eigen::Vector2d* mean_nu) const;
   void symmetrize();
+  /// First-order Gauss-Markov propagation of state k over dt_s (x decays, P towards stationary_var).
+  void gauss_markov_step(int k, double dt_s, double tau_s, double stationary_var);
 
   FusionFilterOptions opt_;
   double floor_fraction_ = -1.0;  // per-update override of opt_.position_floor_fraction (< 0: none)
