@@ -72,10 +72,11 @@ void FusionFilter::advance_to(TimeNs t_ns) {
   // first-order Gauss-Markov residual states: decay towards 0, variance towards the stationary one
   if (opt_.heading_bias_tau_s > 0.0 && heading_stationary_var_ > 0.0)
     gauss_markov_step(2, dt_all, opt_.heading_bias_tau_s, heading_stationary_var_);
+  p_(2, 2) += opt_.heading_bias_rw_rad2ps * dt_all;
   if (opt_.scale_tau_s > 0.0)
     gauss_markov_step(3, dt_all, opt_.scale_tau_s, opt_.initial_scale_sigma * opt_.initial_scale_sigma);
-  p_(2, 2) += opt_.heading_bias_rw_rad2ps * dt_all;
-  if (!(opt_.scale_tau_s > 0.0)) p_(3, 3) += opt_.scale_rw_1ps * dt_all;  // the GM model replaces it
+  else
+    p_(3, 3) += opt_.scale_rw_1ps * dt_all;  // the random walk only without the Gauss-Markov model
   t_ns_ = t_ns;
 }
 
