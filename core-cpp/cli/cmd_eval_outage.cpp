@@ -87,6 +87,15 @@ struct WalkResult {
   double dr_start_sigma_m = kNaNd;
 };
 
+/// ", heading from the course: B +- S deg (N samples)" when the fixes' course went into it.
+std::string course_note(const fusion::PdrCalibration& c) {
+  if (c.course_epochs <= 0 || !(c.course_bias_sigma_rad > 0.0)) return "";
+  char b[128];
+  std::snprintf(b, sizeof b, "; course over ground %.1f +- %.1f deg (%d fixes)", rad_to_deg(c.course_bias_rad),
+                rad_to_deg(c.course_bias_sigma_rad), c.course_epochs);
+  return b;
+}
+
 bool is_gnss(const Sample& s) { return std::holds_alternative<GnssRawSample>(s) || std::holds_alternative<FixSample>(s); }
 
 bool is_gps_fix(const FixSample& f) {
@@ -327,20 +336,8 @@ WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std:
     j["outage_ratio"] = r.ratio;
     j["coverage_68"] = r.epochs_in_window > 0 ? static_cast<double>(r.covered) / r.epochs_in_window : kNaNd;
     j["max_jump_sigma"] = r.max_jump_sigma;
-    j["calibration_before_window"] = {{"valid", r.cal.valid},
-                                      {"scale", r.cal.scale},
-                                      {"scale_sigma", r.cal.scale_sigma},
-                                      {"heading_bias_deg", rad_to_deg(r.cal.heading_bias_rad)},
-                                      {"heading_bias_sigma_deg", rad_to_deg(r.cal.heading_bias_sigma_rad)},
-                                      {"epochs", r.cal.epochs},
-                                      {"baseline_m", r.cal.baseline_m}};
-    j["calibration_fit_before_window"] = {{"scale", r.cal_fit.scale},
-                                          {"scale_sigma", r.cal_fit.scale_sigma},
-                                          {"heading_bias_deg", rad_to_deg(r.cal_fit.heading_bias_rad)},
-                                          {"heading_bias_sigma_deg", rad_to_deg(r.cal_fit.heading_bias_sigma_rad)},
-                                          {"epochs", r.cal_fit.epochs},
-                                          {"baseline_m", r.cal_fit.baseline_m},
-                                          {"residual_rho", r.cal_fit.residual_rho}};
+    j["calibration_before_window"] = pdr_calibration_json(r.cal);
+    j["calibration_fit_before_window"] = pdr_calibration_json(r.cal_fit);
     std::ofstream(stem.string() + ".json") << j.dump(2) << "\n";
   }
   return r;
@@ -395,14 +392,15 @@ int run_eval_outage(const EvalOutageArgs& a) {
                 f1(r.max_jump_t_s).c_str());
     if (r.cal.valid)
       std::printf("  calibration published before the window: scale %.3f +- %.3f, heading bias %.1f +- %.1f deg, %d epochs, "
-                  "baseline %.0f m\n",
+                  "baseline %.0f m%s\n",
                   r.cal.scale, r.cal.scale_sigma, rad_to_deg(r.cal.heading_bias_rad), rad_to_deg(r.cal.heading_bias_sigma_rad),
-                  r.cal.epochs, r.cal.baseline_m);
+                  r.cal.epochs, r.cal.baseline_m, course_note(r.cal).c_str());
     else
       std::printf("  calibration published before the window: none (uncalibrated PDR in the window); last fit: scale "
-                  "%.3f +- %.3f, heading bias %.1f +- %.1f deg, %d epochs, baseline %.0f m, residual lag-1 corr. %.2f\n",
+                  "%.3f +- %.3f, heading bias %.1f +- %.1f deg, %d epochs, baseline %.0f m, residual lag-1 corr. %.2f%s\n",
                   r.cal_fit.scale, r.cal_fit.scale_sigma, rad_to_deg(r.cal_fit.heading_bias_rad),
-                  rad_to_deg(r.cal_fit.heading_bias_sigma_rad), r.cal_fit.epochs, r.cal_fit.baseline_m, r.cal_fit.residual_rho);
+                  rad_to_deg(r.cal_fit.heading_bias_sigma_rad), r.cal_fit.epochs, r.cal_fit.baseline_m, r.cal_fit.residual_rho,
+                  course_note(r.cal_fit).c_str());
     std::fflush(stdout);
     results.push_back(r);
   }

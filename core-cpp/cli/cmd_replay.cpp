@@ -79,11 +79,7 @@ nlohmann::json fusion_summary(const fusion::Navigator& nav) {
           {"mode_change_count", o.mode_change_count},
           {"mode_changes", changes},
           {"counts", counts},
-          {"pdr_calibration",
-           {{"valid", cal.valid}, {"scale", cal.scale}, {"scale_sigma", cal.scale_sigma},
-            {"heading_bias_deg", rad_to_deg(cal.heading_bias_rad)},
-            {"heading_bias_sigma_deg", rad_to_deg(cal.heading_bias_sigma_rad)}, {"window_epochs", cal.epochs},
-            {"baseline_m", cal.baseline_m}}}};
+          {"pdr_calibration", pdr_calibration_json(cal)}};
 }
 
 int run_replay(const ReplayArgs& a) {

@@ -188,6 +188,15 @@ TEST(FusionFilter, HeadingBiasVarianceAfterAWindowFollowsTheGaussMarkovModel) {
   g.initialize(Eigen::Vector2d::Zero(), 3.0, 0);
   g.predict(s);
   EXPECT_NEAR(g.heading_bias_var_after_window(fit, 300.0), fit, 1e-12);
+  // the expected bias fades from the calibrated value as the Gauss-Markov mean: 1/e after tau
+  const double b = 8.0 * kDegToRad;
+  EXPECT_NEAR(f.heading_bias_expected(b, 0.0), b, 1e-12);
+  EXPECT_NEAR(f.heading_bias_expected(b, 300.0), b / std::exp(1.0), 1e-9);
+  EXPECT_NEAR(f.heading_bias_expected(b, 3e4), 0.0, 1e-9);
+  EXPECT_NEAR(g.heading_bias_expected(b, 300.0), b, 1e-12);  // no model: the calibration holds
+  FusionFilter unknown;  // no step yet: the PDR's sigma (the stationary one) is not known
+  unknown.initialize(Eigen::Vector2d::Zero(), 3.0, 0);
+  EXPECT_NEAR(unknown.heading_bias_expected(b, 300.0), b, 1e-12);
 }
 
 // Issue 28: the residual step-scale error is a Gauss-Markov process with the unknown walker's

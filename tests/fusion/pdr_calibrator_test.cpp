@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -20,7 +22,17 @@ struct Walk {
   double bias_drift_rad = 0.0;             // the bias moves linearly by this over the walk
 };
 
-PdrCalibration run(const Walk& w, double minutes, std::uint64_t seed, double multipath_m = 3.0) {
+/// The GNSS course over ground fed beside the positions: none, or the direction the walker
+/// moved `lag_s` earlier (a chipset's velocity filter lags at turns) plus a slow wander and
+/// uniform noise (not the calibrator's Gaussian model).
+struct CourseFeed {
+  bool on = false;
+  double lag_s = 2.0;
+  double wander_rad = 4.0 * kDegToRad, noise_rad = 10.0 * kDegToRad;
+};
+
+PdrCalibration run(const Walk& w, double minutes, std::uint64_t seed, double multipath_m = 3.0,
+                   const CourseFeed& course = {}, PdrCalibration* last = nullptr) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::exponential_distribution<double> expo(1.0);
@@ -31,6 +43,7 @@ PdrCalibration run(const Walk& w, double minutes, std::uint64_t seed, double mul
   double next_turn_s = 30.0;
   const double ph1 = u(rng) * kPi, ph2 = u(rng) * kPi;
   TimeNs next_gnss = kNsPerS;
+  std::vector<std::pair<double, double>> headings;  // (t, true heading) per step, for the lagged course
   for (TimeNs t = 0; t < static_cast<TimeNs>(minutes * 60.0) * kNsPerS; t += step_ns) {
     const double ts = static_cast<double>(t) * 1e-9;
     if (ts > next_turn_s) {  // a turn of 40-140 deg either way every 20-60 s
@@ -38,6 +51,7 @@ PdrCalibration run(const Walk& w, double minutes, std::uint64_t seed, double mul
       next_turn_s = ts + 40.0 + 20.0 * u(rng);
     }
     const double true_len = 0.75 * (1.0 + 0.05 * u(rng));
+    headings.emplace_back(ts, heading);
     e += true_len * std::sin(heading);
     n += true_len * std::cos(heading);
     PdrStep s;
@@ -49,6 +63,13 @@ PdrCalibration run(const Walk& w, double minutes, std::uint64_t seed, double mul
       const double tg = static_cast<double>(next_gnss) * 1e-9;
       const Eigen::Vector2d err(multipath_m * std::sin(2 * kPi * tg / 47.0 + ph1) + laplace(1.5),
                                 multipath_m * std::cos(2 * kPi * tg / 71.0 + ph2) + laplace(1.5));
+      if (course.on) {
+        double h = headings.front().second;
+        for (const auto& [th, hh] : headings)
+          if (th <= tg - course.lag_s) h = hh;
+        cal.add_course(next_gnss, h + course.wander_rad * std::sin(2 * kPi * tg / 83.0 + ph2) + course.noise_rad * u(rng),
+                       1.36, std::nan(""));
+      }
       cal.add_gnss(next_gnss, Eigen::Vector2d(e, n) + err, 4.0);
       next_gnss += kNsPerS;
     }
@@ -58,6 +79,7 @@ PdrCalibration run(const Walk& w, double minutes, std::uint64_t seed, double mul
     std::printf("last fit: epochs %d baseline %.1f scale %.4f +- %.4f bias %.2f +- %.2f deg\n", l.epochs, l.baseline_m, l.scale,
                 l.scale_sigma, l.heading_bias_rad / kDegToRad, l.heading_bias_sigma_rad / kDegToRad);
   }
+  if (last) *last = cal.calibration();
   return cal.published();
 }
 
@@ -109,6 +131,45 @@ TEST(PdrCalibrator, NegativeBiasAndShortStrideAreFoundToo) {
 TEST(PdrCalibrator, NotPublishedBeforeEnoughBaseline) {
   const PdrCalibration c = run(Walk{}, 0.25, 3);  // 15 s: ~20 m walked
   EXPECT_FALSE(c.valid);
+}
+
+// Issue 28: with 15 m of slow multipath over 3 minutes the positions know the heading bias
+// only to several degrees; the course over ground (a chipset's Doppler velocity, lagging 2 s
+// at turns) pins it. Turning epochs are not used (their lagged course is 40-140 deg off).
+TEST(PdrCalibrator, CourseOverGroundPinsTheHeadingBiasWhenPositionsCannot) {
+  const Walk w;
+  for (std::uint64_t seed : {5u, 6u, 7u, 8u}) {
+    PdrCalibration pos, both;
+    run(w, 3.0, seed, 15.0, CourseFeed{}, &pos);
+    CourseFeed f;
+    f.on = true;
+    run(w, 3.0, seed, 15.0, f, &both);
+    std::printf("seed %d: positions %.2f +- %.2f deg; with course %.2f +- %.2f deg (course alone %.2f +- %.2f, %d samples)\n",
+                static_cast<int>(seed), pos.heading_bias_rad / kDegToRad, pos.heading_bias_sigma_rad / kDegToRad,
+                both.heading_bias_rad / kDegToRad, both.heading_bias_sigma_rad / kDegToRad, both.course_bias_rad / kDegToRad,
+                both.course_bias_sigma_rad / kDegToRad, both.course_epochs);
+    EXPECT_EQ(pos.course_epochs, 0);
+    EXPECT_GT(both.course_epochs, 60);
+    EXPECT_LT(both.course_epochs, 176);  // the turning epochs (4-5 turns, 2-5 s each) are refused
+    EXPECT_LT(both.heading_bias_sigma_rad, 0.6 * pos.heading_bias_sigma_rad);
+    EXPECT_NEAR(both.heading_bias_rad, w.true_bias_rad, 2.0 * kDegToRad);
+    // honest: the truth inside 3 sigma
+    EXPECT_LT(std::abs(both.heading_bias_rad - w.true_bias_rad), 3.0 * both.heading_bias_sigma_rad);
+  }
+}
+
+TEST(PdrCalibrator, SlowCourseSamplesAreNotUsed) {
+  PdrCalibrator cal;
+  for (int k = 0; k < 200; ++k) {
+    PdrStep s;
+    s.t_ns = k * 500 * kNsPerMs;
+    s.length_m = 0.7;
+    s.heading_rad = 0.5;
+    cal.add_step(s);
+    if (k % 2 == 0) cal.add_course(s.t_ns, 2.0, 0.3, std::nan(""));  // standing / shuffling: no direction
+  }
+  for (int k = 0; k < 100; ++k) cal.add_gnss(k * kNsPerS, Eigen::Vector2d(0.7 * std::sin(0.5) * 2 * k, 0.7 * std::cos(0.5) * 2 * k), 3.0);
+  EXPECT_EQ(cal.calibration().course_epochs, 0);
 }
 
 TEST(PdrCalibrator, StandingStillNeverPublishes) {

@@ -258,6 +258,20 @@ void ReplayRecorder::write_geojson(const std::string& path, std::size_t max_elli
 
 namespace pdnav::cli {
 
+nlohmann::json pdr_calibration_json(const fusion::PdrCalibration& c) {
+  return {{"valid", c.valid},
+          {"scale", c.scale},
+          {"scale_sigma", c.scale_sigma},
+          {"heading_bias_deg", rad_to_deg(c.heading_bias_rad)},
+          {"heading_bias_sigma_deg", rad_to_deg(c.heading_bias_sigma_rad)},
+          {"window_epochs", c.epochs},
+          {"baseline_m", c.baseline_m},
+          {"residual_rho", c.residual_rho},
+          {"course_epochs", c.course_epochs},
+          {"course_bias_deg", rad_to_deg(c.course_bias_rad)},
+          {"course_bias_sigma_deg", rad_to_deg(c.course_bias_sigma_rad)}};
+}
+
 nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_steps, TimeNs t0_ns) {
   nlohmann::json j;
   j["steps"] = navigator_steps;

@@ -11,6 +11,7 @@
 
 #include "pdnav/geo/estimate.h"
 #include "pdnav/geo/frames.h"
+#include "pdnav/fusion/pdr_calibrator.h"
 #include "pdnav/geo/samples.h"
 #include "pdnav/pdr/pdr.h"
 
@@ -89,6 +90,11 @@ class ReplayRecorder {
 /// of step lengths), placement bouts with their time spans (s from the first sample) and
 /// walking direction in phone axes, steps refused by the motion classifier.
 nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_steps, TimeNs t0_ns);
+
+/// A PDR calibration (fusion::PdrCalibrator) in summary.json / eval-outage JSON: scale and
+/// heading bias with their sigmas, the window's epochs and baseline, the residual correlation
+/// and the course-over-ground samples that went into the heading.
+nlohmann::json pdr_calibration_json(const fusion::PdrCalibration& c);
 
 /// Ellipse outline (lon, lat) polygon for an estimate at probability scale k (1 = 1-sigma).
 std::vector<std::pair<double, double>> ellipse_polygon(const Estimate& e, double k, int points = 36);

@@ -150,6 +150,11 @@ double FusionFilter::heading_bias_var_after_window(double fit_var, double window
   return fit_var + gm_var_about_window_mean(heading_stationary_var_, window_s, opt_.heading_bias_tau_s);
 }
 
+double FusionFilter::heading_bias_expected(double calibrated_rad, double age_s) const {
+  if (!(opt_.heading_bias_tau_s > 0.0) || !(heading_stationary_var_ > 0.0) || !(age_s > 0.0)) return calibrated_rad;
+  return calibrated_rad * std::exp(-age_s / opt_.heading_bias_tau_s);
+}
+
 double FusionFilter::scale_var_after_window(double fit_var, double window_s) const {
   if (!(opt_.scale_tau_s > 0.0) || !(window_s > 0.0)) return fit_var;
   return fit_var + gm_var_about_window_mean(opt_.initial_scale_sigma * opt_.initial_scale_sigma, window_s, opt_.scale_tau_s);

@@ -64,6 +64,7 @@ FusionOptions fusion_options_before_issue28() {
   o.calibration.residual_correlation = false;
   o.calibration.check_bias_drift = false;
   o.calibration.independent_heading = false;
+  o.calibration.use_course = false;
   return o;
 }
 
@@ -443,7 +444,9 @@ struct Navigator::Impl {
     if (!applied.valid) return c;
     c.length_m = s.length_m * applied.scale;
     c.length_sigma_m = s.length_sigma_m * applied.scale;
-    c.heading_rad = wrap_2pi(s.heading_rad - applied.heading_bias_rad);
+    // the heading bias expected now (a Gauss-Markov process: it fades from the calibrated value)
+    c.heading_rad = wrap_2pi(s.heading_rad - ff.heading_bias_expected(applied.heading_bias_rad,
+                                                                      static_cast<double>(s.t_ns - applied.t_ns) * 1e-9));
     return c;
   }
 
@@ -578,6 +581,10 @@ struct Navigator::Impl {
     note_result(r, "Fix");
     if (r.accepted) {
       if (std::isfinite(f.alt_m)) height_m = f.alt_m;
+      // the fix's course over ground (Doppler velocity): a heading-bias sample for the calibrator
+      if (std::isfinite(f.bearing_deg) && std::isfinite(f.speed_mps))
+        cal.add_course(f.t_ns, f.bearing_deg * kDegToRad, f.speed_mps,
+                       std::isfinite(f.bearing_accuracy_deg) && f.bearing_accuracy_deg > 0.0 ? f.bearing_accuracy_deg * kDegToRad : kNaN);
       accepted_gnss(f.t_ns, z, sigma, true, "chipset Fix, accuracy " + fmt(acc) + " m");
       if (r.reacquired) refresh_mode(f.t_ns, "Fix " + r.reason);
     }

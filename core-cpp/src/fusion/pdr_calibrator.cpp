@@ -39,14 +39,104 @@ void PdrCalibrator::add_gnss(TimeNs t_ns, const Eigen::Vector2d& en_m, double si
   fit();
 }
 
+// The course sample: with the PDR direction h (clockwise from north) over the straight path
+// just before t_ns and the GNSS course k, the bias is h - k (PDR heading = true + bias).
+void PdrCalibrator::add_course(TimeNs t_ns, double course_rad, double speed_mps, double sigma_rad) {
+  if (!opt_.use_course || !std::isfinite(course_rad) || !std::isfinite(speed_mps) || speed_mps < opt_.course_min_speed_mps)
+    return;
+  const TimeNs from_ns = t_ns - static_cast<TimeNs>(opt_.course_pdr_span_s * 1e9);
+  if (steps_.empty() || steps_.front().first > from_ns) return;  // the PDR path before t_ns is not kept
+  std::complex<double> prev = pdr_at(from_ns);
+  const std::complex<double> net = pdr_at(t_ns) - prev;
+  double path = 0.0;
+  for (const auto& [t, z] : steps_) {
+    if (t <= from_ns) continue;
+    if (t > t_ns) break;
+    path += std::abs(z - prev);
+    prev = z;
+  }
+  // a turn inside the span, or no step in it: the two directions are not comparable
+  if (!(path > 0.0) || std::abs(net) < opt_.course_min_straightness * path) return;
+  const double pdr_heading = 0.5 * kPi - std::arg(net);
+  const double sigma = std::isfinite(sigma_rad) && sigma_rad > 0.0
+                           ? sigma_rad
+                           : std::atan2(opt_.course_velocity_sigma_mps, speed_mps);
+  courses_.push_back({t_ns, std::remainder(pdr_heading - course_rad, 2.0 * kPi), 1.0 / (sigma * sigma)});
+  const TimeNs win_ns = static_cast<TimeNs>(opt_.window_s * 1e9);
+  while (!courses_.empty() && courses_.front().t_ns < t_ns - win_ns) courses_.pop_front();
+}
+
 void PdrCalibrator::reset() {
   steps_.clear();
   window_.clear();
+  courses_.clear();
   last_ = PdrCalibration{};
   published_ = PdrCalibration{};
 }
 
 namespace {
+/// The effective number of independent samples of a time-correlated series (GNSS errors:
+/// multipath, a chipset's own filter; PDR drift): the smaller of moving time / correlation time
+/// and the AR(1) value n (1 - rho) / (1 + rho) from the residuals' lag-1 autocorrelation rho
+/// (Bayley & Hammersley 1946), so a run of smoothed fixes is never counted as many.
+double effective_samples(double n, double moving_s, double rho, const PdrCalibrationOptions& opt) {
+  const double n_eff_ar = opt.residual_correlation ? n * (1.0 - rho) / (1.0 + rho) : n;
+  return std::clamp(std::min(moving_s / opt.correlation_time_s + 1.0, n_eff_ar), 1.0, n);
+}
+
+/// A heading bias fitted over a window and over its two halves (a: older, b: recent). Their
+/// difference beyond what their own sigmas explain is how far the bias moved in the window (a
+/// walk through magnetic disturbances moves it by tens of degrees); beyond 2 sigma the recent
+/// half is the better predictor of the bias now (Gauss-Markov bias). Either way the bias now is
+/// known no better than that movement: it is added to the sigma. Returns the movement (1-sigma).
+double account_for_drift(double a_rad, double a_var, double b_rad, double b_var, double* bias_rad, double* sigma_rad) {
+  const double d = std::remainder(b_rad - a_rad, 2.0 * kPi);
+  const double var_d = a_var + b_var;
+  const double drift = std::sqrt(std::max(0.0, d * d - var_d));
+  if (d * d > 4.0 * var_d) {
+    *bias_rad = b_rad;
+    *sigma_rad = std::sqrt(b_var);
+  }
+  *sigma_rad = std::hypot(*sigma_rad, drift);
+  return drift;
+}
+
+struct CourseFit {
+  bool ok = false;
+  double bias_rad = 0.0, var_rad2 = 0.0;
+};
+
+/// Weighted circular mean of the course samples over [b, e), its variance inflated like the
+/// position fit's (residual variance factor, effective number of samples).
+template <typename It>
+CourseFit fit_courses(It b, It e, const PdrCalibrationOptions& opt) {
+  CourseFit f;
+  const double n = static_cast<double>(std::distance(b, e));
+  if (n < 2) return f;
+  std::complex<double> sum = 0.0;
+  double w_sum = 0.0, moving_s = 0.0;
+  for (It x = b; x != e; ++x) {
+    sum += x->w * std::polar(1.0, x->bias_rad);
+    w_sum += x->w;
+    // a gap (standing, a turn) counts as at most one correlation time
+    if (x != b) moving_s += std::min(opt.correlation_time_s, static_cast<double>(x->t_ns - std::prev(x)->t_ns) * 1e-9);
+  }
+  f.bias_rad = std::arg(sum);
+  double chi2 = 0.0, r0 = 0.0, r1 = 0.0, prev = 0.0;
+  for (It x = b; x != e; ++x) {
+    const double r = std::remainder(x->bias_rad - f.bias_rad, 2.0 * kPi);
+    chi2 += x->w * r * r;
+    r0 += r * r;
+    if (x != b) r1 += prev * r;
+    prev = r;
+  }
+  const double rho = r0 > 0.0 ? std::clamp(r1 / r0, 0.0, 0.999) : 0.0;
+  const double var_factor = std::max(1.0, chi2 / (n - 1.0));
+  f.var_rad2 = var_factor / w_sum * (n / effective_samples(n, moving_s, rho, opt));
+  f.ok = true;
+  return f;
+}
+
 struct RangeFit {
   bool ok = false;
   std::complex<double> gain = 0.0;
@@ -100,14 +190,8 @@ static RangeFit fit_range(It b, It e, const PdrCalibrationOptions& opt) {
   }
   const double dof = std::max(1.0, 2.0 * n - 4.0);
   const double var_factor = std::max(1.0, chi2 / dof);
-  // Effective number of independent epochs: GNSS errors (multipath, a chipset's own filter) and
-  // PDR drift make the residuals time-correlated. The smaller of span / correlation_time and
-  // the AR(1) value n (1 - rho) / (1 + rho) from the residuals' lag-1 autocorrelation rho
-  // (Bayley & Hammersley 1946), so a run of smoothed fixes is never counted as many.
   f.rho = r0 > 0.0 ? std::clamp(r1 / r0, 0.0, 0.999) : 0.0;
-  const double n_eff_ar = opt.residual_correlation ? n * (1.0 - f.rho) / (1.0 + f.rho) : n;
-  const double n_eff = std::clamp(std::min(f.moving_s / opt.correlation_time_s + 1.0, n_eff_ar), 1.0, n);
-  f.var_component = var_factor / spp * (n / n_eff);
+  f.var_component = var_factor / spp * (n / effective_samples(n, f.moving_s, f.rho, opt));
   f.ok = true;
   return f;
 }
@@ -127,10 +211,8 @@ void PdrCalibrator::fit() {
   c.heading_bias_rad = std::arg(gain);
   c.scale_sigma = std::sqrt(var_component);
   c.heading_bias_sigma_rad = c.scale > 0.0 ? std::sqrt(var_component) / c.scale : kPi;
-  // Did the bias stay put over the window? Fit the two halves of the PDR path separately: their
-  // difference beyond what their own sigmas explain is how far the bias moved in the window
-  // (the fit above is its average; a walk through magnetic disturbances moves it by tens of
-  // degrees). Published as heading_bias_drift_sigma_rad; the fused filter carries it.
+  // Did the bias stay put over the window? Fit the two halves of the PDR path separately
+  // (account_for_drift); the movement is published as heading_bias_drift_sigma_rad.
   if (opt_.check_bias_drift && window_.size() >= 6) {
     double path = 0.0;
     for (std::size_t i = 1; i < window_.size(); ++i) path += std::abs(window_[i].p - window_[i - 1].p);
@@ -142,18 +224,28 @@ void PdrCalibrator::fit() {
     }
     const auto m = window_.begin() + static_cast<std::ptrdiff_t>(std::clamp<std::size_t>(mid, 3, window_.size() - 3));
     const RangeFit a = fit_range(window_.begin(), m, opt_), b = fit_range(m, window_.end(), opt_);
-    if (a.ok && b.ok && std::abs(a.gain) > 0.0 && std::abs(b.gain) > 0.0) {
-      const double d = std::arg(b.gain / a.gain);
-      const double var_d = a.var_component / std::norm(a.gain) + b.var_component / std::norm(b.gain);
-      c.heading_bias_drift_sigma_rad = std::sqrt(std::max(0.0, d * d - var_d));
-      // moved beyond 2 sigma: the recent half is the better predictor of the bias now
-      // (Gauss-Markov bias), the scale stays the whole window's
-      if (d * d > 4.0 * var_d) {
-        c.heading_bias_rad = std::arg(b.gain);
-        c.heading_bias_sigma_rad = std::sqrt(b.var_component) / std::abs(b.gain);
-      }
-      // and it keeps moving: the bias now is known no better than that
-      c.heading_bias_sigma_rad = std::hypot(c.heading_bias_sigma_rad, c.heading_bias_drift_sigma_rad);
+    if (a.ok && b.ok && std::abs(a.gain) > 0.0 && std::abs(b.gain) > 0.0)  // (the scale stays the whole window's)
+      c.heading_bias_drift_sigma_rad =
+          account_for_drift(std::arg(a.gain), a.var_component / std::norm(a.gain), std::arg(b.gain),
+                            b.var_component / std::norm(b.gain), &c.heading_bias_rad, &c.heading_bias_sigma_rad);
+  }
+  // The GNSS course: a second, independent sample of the heading bias (Doppler velocity, not
+  // positions), with the same drift check over its two halves; inverse-variance combined.
+  c.course_epochs = static_cast<int>(courses_.size());
+  if (opt_.use_course && c.course_epochs >= opt_.course_min_epochs) {
+    const CourseFit k = fit_courses(courses_.begin(), courses_.end(), opt_);
+    double kb = k.bias_rad, ks = std::sqrt(k.var_rad2);
+    if (opt_.check_bias_drift && courses_.size() >= 6) {
+      const auto m = courses_.begin() + static_cast<std::ptrdiff_t>(courses_.size() / 2);
+      const CourseFit a = fit_courses(courses_.begin(), m, opt_), b = fit_courses(m, courses_.end(), opt_);
+      if (a.ok && b.ok) account_for_drift(a.bias_rad, a.var_rad2, b.bias_rad, b.var_rad2, &kb, &ks);
+    }
+    if (k.ok && ks > 0.0 && c.heading_bias_sigma_rad > 0.0) {
+      c.course_bias_rad = kb;
+      c.course_bias_sigma_rad = ks;
+      const double wp = 1.0 / (c.heading_bias_sigma_rad * c.heading_bias_sigma_rad), wk = 1.0 / (ks * ks);
+      c.heading_bias_rad = std::remainder(c.heading_bias_rad + std::remainder(kb - c.heading_bias_rad, 2.0 * kPi) * wk / (wp + wk), 2.0 * kPi);
+      c.heading_bias_sigma_rad = 1.0 / std::sqrt(wp + wk);
     }
   }
   // Scale and heading bias are published independently: a heading fit that does not know the

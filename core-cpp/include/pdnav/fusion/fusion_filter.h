@@ -101,6 +101,12 @@ class FusionFilter {
   /// by sigma^2 g(W / tau), g(u) = 1 - 2 (1 - e^-u) / u + 2 (u - 1 + e^-u) / u^2 (the
   /// exponential autocovariance integrated over the window). Without the model: fit_var_rad2.
   double heading_bias_var_after_window(double fit_var_rad2, double window_s) const;
+  /// The heading bias expected age_s after a calibration of calibrated_rad: the Gauss-Markov
+  /// mean decays as exp(-age / heading_bias_tau_s) while its variance relaxes to the stationary
+  /// one (the residual state does the same; the sources, magnetic disturbances along the way,
+  /// average out). The step scale is not treated so: a walker's stride differs from the model
+  /// by a constant of its own. Without the model: calibrated_rad.
+  double heading_bias_expected(double calibrated_rad, double age_s) const;
   /// The same for the step scale (scale_tau_s, initial_scale_sigma): the variance of the scale
   /// error now given a fit of its window average with variance fit_var.
   double scale_var_after_window(double fit_var, double window_s) const;
