@@ -521,8 +521,13 @@ struct Navigator::Impl {
       const double sd = sol.disp_source == "tdcp" ? fo().tdcp_sigma_m : fo().doppler_sigma_mps * sol.disp_dt_s;
       const Eigen::Vector2d before = ff.position_en_m();
       double nis = 0.0;
-      if (ff.update_displacement(t, t - ns(sol.disp_dt_s), sol.tdcp_disp_m.head<2>(), sd * sd * Eigen::Matrix2d::Identity(), &nis))
+      if (ff.update_displacement(t, t - ns(sol.disp_dt_s), sol.tdcp_disp_m.head<2>(), sd * sd * Eigen::Matrix2d::Identity(), &nis)) {
         ++counts["GNSS: " + sol.disp_source + " displacement used"];
+        // its direction is the course over ground since the last epoch: a heading-bias sample
+        const Eigen::Vector2d d = sol.tdcp_disp_m.head<2>();
+        if (d.norm() > 0.0)
+          cal.add_course(t, std::atan2(d.x(), d.y()), d.norm() / sol.disp_dt_s, std::atan2(sd, d.norm()));
+      }
       else if (ff.clone_t_ns() >= 0)
         ++counts["GNSS: " + sol.disp_source + " displacement rejected or unmatched"];
       after_update(before);
