@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -28,7 +30,10 @@ struct WalkResult {
   std::vector<ModeChange> changes;
 };
 
-WalkResult walk(std::uint64_t seed, double outage_s = 180.0, double start_off_m = 0.0) {
+/// with_course: the Fix rows carry the chipset's course over ground (the direction walked 1 s
+/// earlier, +-10 deg uniform) and speed; multipath_m: amplitude of the fixes' slow error.
+WalkResult walk(std::uint64_t seed, double outage_s = 180.0, double start_off_m = 0.0, bool with_course = false,
+                double multipath_m = 2.0) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   NavigatorConfig cfg;  // kAuto: the fused estimate
@@ -42,7 +47,8 @@ WalkResult walk(std::uint64_t seed, double outage_s = 180.0, double start_off_m 
   const double bias = 8.0 * kDegToRad;                   // the phone's heading error
   const geo::LocalFrame frame(geo::Geodetic::from_deg(42.5, 1.5, 0.0));
   Eigen::Vector2d truth = Eigen::Vector2d::Zero();
-  double heading = 0.4, next_turn_s = 40.0;
+  double heading = 0.4, next_turn_s = 40.0, heading_1s_ago = heading;
+  std::vector<std::pair<double, double>> recent;  // (t, heading) of the last steps
   const double open_s = 300.0, end_s = open_s + outage_s + 60.0;
   TimeNs next_fix = 2 * kNsPerS;
   WalkResult res;
@@ -60,15 +66,24 @@ WalkResult walk(std::uint64_t seed, double outage_s = 180.0, double start_off_m 
       next_turn_s = ts + 45.0 + 15.0 * u(rng);
     }
     truth += true_len * Eigen::Vector2d(std::sin(heading), std::cos(heading));
+    recent.emplace_back(ts, heading);
+    while (recent.size() > 1 && recent[1].first <= ts - 1.0) recent.erase(recent.begin());
+    heading_1s_ago = recent.front().second;
     const double shown_heading = heading + bias + 4.0 * kDegToRad * u(rng);
     for (const Sample& s : test::step_events(t - kNsPerMs, t, test::chest_facing(shown_heading))) nav.feed(s);
     const bool outage = ts >= open_s && ts < open_s + outage_s;
     while (next_fix <= t) {
       const double tf = static_cast<double>(next_fix) * 1e-9;
       if (!outage) {
-        const Eigen::Vector2d err(2.0 * std::sin(2 * kPi * tf / 53.0 + ph) + 2.0 * u(rng), 2.0 * std::cos(2 * kPi * tf / 67.0) + 2.0 * u(rng));
+        const Eigen::Vector2d err(multipath_m * std::sin(2 * kPi * tf / 53.0 + ph) + 2.0 * u(rng),
+                                  multipath_m * std::cos(2 * kPi * tf / 67.0) + 2.0 * u(rng));
         const geo::Geodetic g = frame.to_geodetic(geo::Enu(truth.x() + err.x(), truth.y() + err.y(), 0.0));
-        nav.feed(test::gps_fix(next_fix, g, 0.0, 4.0));
+        FixSample f = test::gps_fix(next_fix, g, 0.0, 2.0 + multipath_m);
+        if (with_course) {
+          f.bearing_deg = rad_to_deg(heading_1s_ago + 10.0 * kDegToRad * u(rng));
+          f.speed_mps = true_len / 0.55;
+        }
+        nav.feed(f);
       }
       next_fix += kNsPerS;
     }
@@ -118,6 +133,27 @@ TEST(NavigatorFusionWalk, CalibratedPdrCarriesThroughA3MinuteOutageWithoutJumps)
       if (lost && c.to != FusionMode::kPdr && c.reason.find("re-acquired") != std::string::npos) back = true;
     }
     EXPECT_TRUE(lost && back) << seed;
+  }
+}
+
+// Issue 28: fixes with 8 m of slow multipath leave the heading bias uncertain; their course over
+// ground (Fix bearing) reaches the calibrator through the Navigator and pins it.
+TEST(NavigatorFusionWalk, TheFixesCourseOverGroundCalibratesTheHeading) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const WalkResult pos = walk(seed, 180.0, 0.0, false, 8.0), both = walk(seed, 180.0, 0.0, true, 8.0);
+    const WalkResult clean = walk(seed);  // 2 m multipath: the bias as the PDR sees it (8 deg + its own offset)
+    std::printf("seed %d: positions only: bias %.1f +- %.1f deg (%s); with the course: %.1f +- %.1f deg from %d fixes; "
+                "end of outage fused %.1f m vs %.1f m\n",
+                static_cast<int>(seed), rad_to_deg(pos.cal.heading_bias_rad), rad_to_deg(pos.cal.heading_bias_sigma_rad),
+                pos.cal.heading_applied ? "applied" : "not applied", rad_to_deg(both.cal.heading_bias_rad),
+                rad_to_deg(both.cal.heading_bias_sigma_rad), both.cal.course_epochs, both.fused_err_end_outage_m,
+                pos.fused_err_end_outage_m);
+    ASSERT_TRUE(both.cal.valid) << seed;
+    EXPECT_EQ(pos.cal.course_epochs, 0) << seed;
+    EXPECT_GT(both.cal.course_epochs, 100) << seed;
+    EXPECT_NEAR(rad_to_deg(both.cal.heading_bias_rad), rad_to_deg(clean.cal.heading_bias_rad), 1.0) << seed;
+    EXPECT_LT(both.fused_err_end_outage_m, pos.fused_err_end_outage_m) << seed;
+    EXPECT_LE(both.max_jump_sigma, 3.0) << seed;
   }
 }
 
