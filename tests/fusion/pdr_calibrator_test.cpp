@@ -172,6 +172,26 @@ TEST(PdrCalibrator, SlowCourseSamplesAreNotUsed) {
   EXPECT_EQ(cal.calibration().course_epochs, 0);
 }
 
+// After an outage of the course (e.g. GNSS lost, positions back first) the old samples leave
+// the window with the positions, not when the next course sample comes.
+TEST(PdrCalibrator, CourseSamplesLeaveTheWindowWithThePositions) {
+  PdrCalibrator cal;
+  for (int k = 0; k < 1400; ++k) {  // 700 s straight at 1.4 m/s
+    PdrStep s;
+    s.t_ns = k * 500 * kNsPerMs;
+    s.length_m = 0.7;
+    s.heading_rad = 0.5;
+    cal.add_step(s);
+    const double d = 0.7 * (k + 1);
+    if (k % 2 == 1) {
+      if (k < 200) cal.add_course(s.t_ns, 0.5, 1.4, std::nan(""));  // the first 100 s only
+      cal.add_gnss(s.t_ns, Eigen::Vector2d(d * std::sin(0.5), d * std::cos(0.5)), 3.0);
+    }
+    if (k == 300) EXPECT_GT(cal.calibration().course_epochs, 90);
+  }
+  EXPECT_EQ(cal.calibration().course_epochs, 0);
+}
+
 TEST(PdrCalibrator, StandingStillNeverPublishes) {
   PdrCalibrator cal;
   for (int k = 0; k < 600; ++k) cal.add_gnss(k * kNsPerS, Eigen::Vector2d(0.3 * std::sin(k), 0.2), 4.0);

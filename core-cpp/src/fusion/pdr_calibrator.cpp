@@ -36,6 +36,7 @@ void PdrCalibrator::add_gnss(TimeNs t_ns, const Eigen::Vector2d& en_m, double si
   window_.push_back({t_ns, pdr_at(t_ns), std::complex<double>(en_m.x(), en_m.y()), 1.0 / (sigma_m * sigma_m)});
   const TimeNs win_ns = static_cast<TimeNs>(opt_.window_s * 1e9);
   while (!window_.empty() && window_.front().t_ns < t_ns - win_ns) window_.pop_front();
+  while (!courses_.empty() && courses_.front().t_ns < t_ns - win_ns) courses_.pop_front();  // (after an outage)
   fit();
 }
 
