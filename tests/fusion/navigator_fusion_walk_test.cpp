@@ -31,9 +31,10 @@ struct WalkResult {
 };
 
 /// with_course: the Fix rows carry the chipset's course over ground (the direction walked 1 s
-/// earlier, +-10 deg uniform) and speed; multipath_m: amplitude of the fixes' slow error.
+/// earlier, +-10 deg uniform) and speed; multipath_m: amplitude of the fixes' slow error;
+/// bearing_always_zero: the course written as Android's "no bearing" value.
 WalkResult walk(std::uint64_t seed, double outage_s = 180.0, double start_off_m = 0.0, bool with_course = false,
-                double multipath_m = 2.0) {
+                double multipath_m = 2.0, bool bearing_always_zero = false) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   NavigatorConfig cfg;  // kAuto: the fused estimate
@@ -80,7 +81,7 @@ WalkResult walk(std::uint64_t seed, double outage_s = 180.0, double start_off_m 
         const geo::Geodetic g = frame.to_geodetic(geo::Enu(truth.x() + err.x(), truth.y() + err.y(), 0.0));
         FixSample f = test::gps_fix(next_fix, g, 0.0, 2.0 + multipath_m);
         if (with_course) {
-          f.bearing_deg = rad_to_deg(heading_1s_ago + 10.0 * kDegToRad * u(rng));
+          f.bearing_deg = bearing_always_zero ? 0.0 : rad_to_deg(heading_1s_ago + 10.0 * kDegToRad * u(rng));
           f.speed_mps = true_len / 0.55;
         }
         nav.feed(f);
@@ -155,6 +156,8 @@ TEST(NavigatorFusionWalk, TheFixesCourseOverGroundCalibratesTheHeading) {
     EXPECT_LT(both.fused_err_end_outage_m, pos.fused_err_end_outage_m) << seed;
     EXPECT_LE(both.max_jump_sigma, 3.0) << seed;
   }
+  // a logger that writes Android's "no bearing" (0.0) with a speed: not a course
+  EXPECT_EQ(walk(1, 180.0, 0.0, true, 8.0, true).cal.course_epochs, 0);
 }
 
 TEST(NavigatorFusionWalk, AWrongStartIsCorrectedByGnssWithoutAShownJump) {

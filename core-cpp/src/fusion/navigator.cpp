@@ -586,8 +586,9 @@ struct Navigator::Impl {
     note_result(r, "Fix");
     if (r.accepted) {
       if (std::isfinite(f.alt_m)) height_m = f.alt_m;
-      // the fix's course over ground (Doppler velocity): a heading-bias sample for the calibrator
-      if (std::isfinite(f.bearing_deg) && std::isfinite(f.speed_mps))
+      // the fix's course over ground (Doppler velocity): a heading-bias sample for the calibrator.
+      // Exactly 0 is Android's Location.getBearing() without hasBearing() (loggers write it so)
+      if (std::isfinite(f.bearing_deg) && f.bearing_deg != 0.0 && std::isfinite(f.speed_mps))
         cal.add_course(f.t_ns, f.bearing_deg * kDegToRad, f.speed_mps,
                        std::isfinite(f.bearing_accuracy_deg) && f.bearing_accuracy_deg > 0.0 ? f.bearing_accuracy_deg * kDegToRad : kNaN);
       accepted_gnss(f.t_ns, z, sigma, true, "chipset Fix, accuracy " + fmt(acc) + " m");
