@@ -1,6 +1,7 @@
 // RouteEngine (APT Sec. VI) on hand-made graphs with known answers, and on simulated walks
 // through a seeded synthetic town (not the Andorra data: that is the eval-route ctest).
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <random>
 
@@ -101,6 +102,27 @@ TEST(RouteEngine, TurnSnapsToTheCornerAndKeepsOnlyMatchingBranch) {
   EXPECT_NEAR(est.en_m.x(), 0.0, 0.5);
   EXPECT_NEAR(est.en_m.y(), 3.0, 0.5);
   for (const auto& c : e.candidates(1000)) EXPECT_NEAR(c.heading_rad, 0.0, 1e-9);  // all northbound
+}
+
+// The reported covariance carries the along-track variance of the steps' scale (5 % of the
+// distance since the last snap) along the street: the routes of a cluster move together, so
+// their spread alone stayed ~1 m while a scale error drifts the position along the street.
+TEST(RouteEngine, ReportedCovarianceGrowsAlongTheStreetNotAcrossIt) {
+  auto g = crossing();
+  RouteEngine e(RouteOptions{}, g, 1);
+  e.feed(fix_at(*g, {0, -190}, 3.0, kNsPerS));
+  TimeNs t = walk(e, kNsPerS, 20, 0.75, 0.0);  // 15 m north on the south arm
+  const Estimate a = e.estimate();
+  t = walk(e, t, 160, 0.75, 0.0);              // 120 m more, no turn
+  const Estimate b = e.estimate();
+  ASSERT_TRUE(a.valid() && b.valid());
+  const double d_a = 15.0 + 0.0, d_b = 135.0;  // walked since the fix (the routes' last snap)
+  std::printf("along-track sigma %.1f m after %.0f m, %.1f m after %.0f m; across %.1f m\n", std::sqrt(a.cov_en_m2(1, 1)), d_a,
+              std::sqrt(b.cov_en_m2(1, 1)), d_b, std::sqrt(b.cov_en_m2(0, 0)));
+  EXPECT_GT(std::sqrt(b.cov_en_m2(1, 1)), 0.05 * d_b);         // north: along the street
+  EXPECT_LT(std::sqrt(b.cov_en_m2(1, 1)), 0.05 * d_b + 10.0);  // (plus the routes' spread)
+  EXPECT_LT(std::sqrt(b.cov_en_m2(0, 0)), 1.5);                // east: across it
+  EXPECT_GT(b.cov_en_m2(1, 1), 4.0 * a.cov_en_m2(1, 1));
 }
 
 TEST(RouteEngine, UnmatchableTurnLosesAllRoutesAndNextFixRestarts) {

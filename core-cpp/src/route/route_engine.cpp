@@ -401,7 +401,12 @@ void RouteEngine::update_clusters() {
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return w[a] > w[b]; });
   std::vector<Eigen::Vector2d> seeds;
-  struct Acc { double w = 0, wxx = 0, wxy = 0, wyy = 0; Eigen::Vector2d wx = Eigen::Vector2d::Zero(); std::size_t n = 0; };
+  struct Acc {
+    double w = 0, wxx = 0, wxy = 0, wyy = 0;
+    Eigen::Vector2d wx = Eigen::Vector2d::Zero();
+    Eigen::Matrix2d w_along = Eigen::Matrix2d::Zero();  // sum of w (sigma_s d)^2 u u^T
+    std::size_t n = 0;
+  };
   std::vector<Acc> acc;
   const double r2 = opt_.cluster_radius_m * opt_.cluster_radius_m;
   for (const auto i : order) {
@@ -417,6 +422,11 @@ void RouteEngine::update_clusters() {
     const Eigen::Vector2d d = p - seeds[c];  // relative to the seed for numerical stability
     a.w += w[i]; a.wx += w[i] * d; a.wxx += w[i] * d.x() * d.x(); a.wxy += w[i] * d.x() * d.y();
     a.wyy += w[i] * d.y() * d.y(); ++a.n;
+    // the route's own along-track variance (the one reseed_along_track weighs routes by): a step
+    // scale error moves every route of a cluster together, so their spread does not show it
+    const Eigen::Vector2d& u = graph_->segment(routes_[i].seg).dir;
+    const double s_along = kStepScaleSigma * routes_[i].since_snap_m;
+    a.w_along += w[i] * s_along * s_along * u * u.transpose();
   }
   for (std::size_t c = 0; c < seeds.size(); ++c) {
     const Acc& a = acc[c];
@@ -428,6 +438,7 @@ void RouteEngine::update_clusters() {
     if (a.w > 0) {
       cl.cov_en_m2 << a.wxx / a.w - m.x() * m.x(), a.wxy / a.w - m.x() * m.y(),
                       a.wxy / a.w - m.x() * m.y(), a.wyy / a.w - m.y() * m.y();
+      cl.cov_en_m2 += a.w_along / a.w;
     }
     clusters_.push_back(cl);
   }
