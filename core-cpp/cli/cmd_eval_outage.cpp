@@ -87,11 +87,12 @@ struct WalkResult {
   double dr_start_sigma_m = kNaNd;
 };
 
-/// ", heading from the course: B +- S deg (N samples)" when the fixes' course went into it.
+/// "; course over ground B +- S deg (N epochs)" when the GNSS course (a Fix's bearing or a
+/// TDCP/Doppler displacement's direction) went into the heading.
 std::string course_note(const fusion::PdrCalibration& c) {
   if (c.course_epochs <= 0 || !(c.course_bias_sigma_rad > 0.0)) return "";
   char b[128];
-  std::snprintf(b, sizeof b, "; course over ground %.1f +- %.1f deg (%d fixes)", rad_to_deg(c.course_bias_rad),
+  std::snprintf(b, sizeof b, "; course over ground %.1f +- %.1f deg (%d epochs)", rad_to_deg(c.course_bias_rad),
                 rad_to_deg(c.course_bias_sigma_rad), c.course_epochs);
   return b;
 }

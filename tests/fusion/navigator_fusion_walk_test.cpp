@@ -48,8 +48,8 @@ WalkResult walk(std::uint64_t seed, double outage_s = 180.0, double start_off_m 
   const double bias = 8.0 * kDegToRad;                   // the phone's heading error
   const geo::LocalFrame frame(geo::Geodetic::from_deg(42.5, 1.5, 0.0));
   Eigen::Vector2d truth = Eigen::Vector2d::Zero();
-  double heading = 0.4, next_turn_s = 40.0, heading_1s_ago = heading;
-  std::vector<std::pair<double, double>> recent;  // (t, heading) of the last steps
+  double heading = 0.4, next_turn_s = 40.0;
+  std::vector<std::pair<double, double>> recent;  // (t, heading) of the steps of the last second
   const double open_s = 300.0, end_s = open_s + outage_s + 60.0;
   TimeNs next_fix = 2 * kNsPerS;
   WalkResult res;
@@ -69,7 +69,6 @@ WalkResult walk(std::uint64_t seed, double outage_s = 180.0, double start_off_m 
     truth += true_len * Eigen::Vector2d(std::sin(heading), std::cos(heading));
     recent.emplace_back(ts, heading);
     while (recent.size() > 1 && recent[1].first <= ts - 1.0) recent.erase(recent.begin());
-    heading_1s_ago = recent.front().second;
     const double shown_heading = heading + bias + 4.0 * kDegToRad * u(rng);
     for (const Sample& s : test::step_events(t - kNsPerMs, t, test::chest_facing(shown_heading))) nav.feed(s);
     const bool outage = ts >= open_s && ts < open_s + outage_s;
@@ -81,7 +80,7 @@ WalkResult walk(std::uint64_t seed, double outage_s = 180.0, double start_off_m 
         const geo::Geodetic g = frame.to_geodetic(geo::Enu(truth.x() + err.x(), truth.y() + err.y(), 0.0));
         FixSample f = test::gps_fix(next_fix, g, 0.0, 2.0 + multipath_m);
         if (with_course) {
-          f.bearing_deg = bearing_always_zero ? 0.0 : rad_to_deg(heading_1s_ago + 10.0 * kDegToRad * u(rng));
+          f.bearing_deg = bearing_always_zero ? 0.0 : rad_to_deg(recent.front().second + 10.0 * kDegToRad * u(rng));
           f.speed_mps = true_len / 0.55;
         }
         nav.feed(f);

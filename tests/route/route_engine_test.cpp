@@ -116,7 +116,7 @@ TEST(RouteEngine, ReportedCovarianceGrowsAlongTheStreetNotAcrossIt) {
   t = walk(e, t, 160, 0.75, 0.0);              // 120 m more, no turn
   const Estimate b = e.estimate();
   ASSERT_TRUE(a.valid() && b.valid());
-  const double d_a = 15.0 + 0.0, d_b = 135.0;  // walked since the fix (the routes' last snap)
+  const double d_a = 15.0, d_b = 135.0;  // walked since the fix (the routes' last snap)
   std::printf("along-track sigma %.1f m after %.0f m, %.1f m after %.0f m; across %.1f m\n", std::sqrt(a.cov_en_m2(1, 1)), d_a,
               std::sqrt(b.cov_en_m2(1, 1)), d_b, std::sqrt(b.cov_en_m2(0, 0)));
   EXPECT_GT(std::sqrt(b.cov_en_m2(1, 1)), 0.05 * d_b);         // north: along the street

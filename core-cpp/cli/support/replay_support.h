@@ -9,9 +9,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pdnav/fusion/pdr_calibrator.h"
 #include "pdnav/geo/estimate.h"
 #include "pdnav/geo/frames.h"
-#include "pdnav/fusion/pdr_calibrator.h"
 #include "pdnav/geo/samples.h"
 #include "pdnav/pdr/pdr.h"
 

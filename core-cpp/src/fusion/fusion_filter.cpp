@@ -70,7 +70,7 @@ void FusionFilter::advance_to(TimeNs t_ns) {
   }
   const double dt_all = static_cast<double>(t_ns - t_ns_) * 1e-9;
   // first-order Gauss-Markov residual states: decay towards 0, variance towards the stationary one
-  if (opt_.heading_bias_tau_s > 0.0 && heading_stationary_var_ > 0.0)
+  if (heading_bias_gauss_markov())
     gauss_markov_step(2, dt_all, opt_.heading_bias_tau_s, heading_stationary_var_);
   p_(2, 2) += opt_.heading_bias_rw_rad2ps * dt_all;
   if (opt_.scale_tau_s > 0.0)
@@ -146,12 +146,12 @@ double gm_var_about_window_mean(double var, double window_s, double tau_s) {
 }  // namespace
 
 double FusionFilter::heading_bias_var_after_window(double fit_var, double window_s) const {
-  if (!(opt_.heading_bias_tau_s > 0.0) || !(heading_stationary_var_ > 0.0) || !(window_s > 0.0)) return fit_var;
+  if (!heading_bias_gauss_markov() || !(window_s > 0.0)) return fit_var;
   return fit_var + gm_var_about_window_mean(heading_stationary_var_, window_s, opt_.heading_bias_tau_s);
 }
 
 double FusionFilter::heading_bias_expected(double calibrated_rad, double age_s) const {
-  if (!(opt_.heading_bias_tau_s > 0.0) || !(heading_stationary_var_ > 0.0) || !(age_s > 0.0)) return calibrated_rad;
+  if (!heading_bias_gauss_markov() || !(age_s > 0.0)) return calibrated_rad;
   return calibrated_rad * std::exp(-age_s / opt_.heading_bias_tau_s);
 }
 

@@ -589,8 +589,7 @@ struct Navigator::Impl {
       // the fix's course over ground (Doppler velocity): a heading-bias sample for the calibrator.
       // Exactly 0 is Android's Location.getBearing() without hasBearing() (loggers write it so)
       if (std::isfinite(f.bearing_deg) && f.bearing_deg != 0.0 && std::isfinite(f.speed_mps))
-        cal.add_course(f.t_ns, f.bearing_deg * kDegToRad, f.speed_mps,
-                       std::isfinite(f.bearing_accuracy_deg) && f.bearing_accuracy_deg > 0.0 ? f.bearing_accuracy_deg * kDegToRad : kNaN);
+        cal.add_course(f.t_ns, f.bearing_deg * kDegToRad, f.speed_mps, f.bearing_accuracy_deg * kDegToRad);
       accepted_gnss(f.t_ns, z, sigma, true, "chipset Fix, accuracy " + fmt(acc) + " m");
       if (r.reacquired) refresh_mode(f.t_ns, "Fix " + r.reason);
     }

@@ -34,10 +34,16 @@ std::complex<double> PdrCalibrator::pdr_at(TimeNs t_ns) const {
 void PdrCalibrator::add_gnss(TimeNs t_ns, const Eigen::Vector2d& en_m, double sigma_m) {
   if (!en_m.allFinite() || !(sigma_m > 0.0) || !std::isfinite(sigma_m)) return;
   window_.push_back({t_ns, pdr_at(t_ns), std::complex<double>(en_m.x(), en_m.y()), 1.0 / (sigma_m * sigma_m)});
-  const TimeNs win_ns = static_cast<TimeNs>(opt_.window_s * 1e9);
-  while (!window_.empty() && window_.front().t_ns < t_ns - win_ns) window_.pop_front();
-  while (!courses_.empty() && courses_.front().t_ns < t_ns - win_ns) courses_.pop_front();  // (after an outage)
+  forget_before_window(t_ns);
   fit();
+}
+
+// Positions and course samples leave the window together (course samples from before an
+// outage go with the positions, not when the next course sample comes).
+void PdrCalibrator::forget_before_window(TimeNs t_ns) {
+  const TimeNs start_ns = t_ns - static_cast<TimeNs>(opt_.window_s * 1e9);
+  while (!window_.empty() && window_.front().t_ns < start_ns) window_.pop_front();
+  while (!courses_.empty() && courses_.front().t_ns < start_ns) courses_.pop_front();
 }
 
 // The course sample: with the PDR direction h (clockwise from north) over the straight path
@@ -63,8 +69,7 @@ void PdrCalibrator::add_course(TimeNs t_ns, double course_rad, double speed_mps,
                            ? sigma_rad
                            : std::atan2(opt_.course_velocity_sigma_mps, speed_mps);
   courses_.push_back({t_ns, std::remainder(pdr_heading - course_rad, 2.0 * kPi), 1.0 / (sigma * sigma)});
-  const TimeNs win_ns = static_cast<TimeNs>(opt_.window_s * 1e9);
-  while (!courses_.empty() && courses_.front().t_ns < t_ns - win_ns) courses_.pop_front();
+  forget_before_window(t_ns);
 }
 
 void PdrCalibrator::reset() {

@@ -156,6 +156,9 @@ class FusionFilter {
   void symmetrize();
   /// First-order Gauss-Markov propagation of state k over dt_s (x decays, P towards stationary_var).
   void gauss_markov_step(int k, double dt_s, double tau_s, double stationary_var);
+  /// The heading bias follows the Gauss-Markov model: a correlation time and the PDR's stated
+  /// sigma (the stationary one) known from a step.
+  bool heading_bias_gauss_markov() const { return opt_.heading_bias_tau_s > 0.0 && heading_stationary_var_ > 0.0; }
 
   FusionFilterOptions opt_;
   double floor_fraction_ = -1.0;  // per-update override of opt_.position_floor_fraction (< 0: none)

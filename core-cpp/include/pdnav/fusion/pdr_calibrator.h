@@ -78,7 +78,7 @@ class PdrCalibrator {
   /// paired with the PDR track at the same time (steps after t_ns are not counted).
   void add_gnss(TimeNs t_ns, const Eigen::Vector2d& en_m, double sigma_m);
   /// The GNSS course over ground at t_ns (clockwise from north) and speed, with the course's
-  /// 1-sigma if the receiver states one (NaN: from the speed, course_velocity_sigma_mps). Call
+  /// 1-sigma if the receiver states one (NaN or <= 0: from the speed, course_velocity_sigma_mps). Call
   /// before add_gnss of the same epoch; a slow or turning epoch is not used.
   void add_course(TimeNs t_ns, double course_rad, double speed_mps, double sigma_rad);
   /// Forget everything (e.g. the user changed the phone's placement).
@@ -93,6 +93,7 @@ class PdrCalibrator {
   struct Pair { TimeNs t_ns; std::complex<double> p, g; double w; };
   struct Course { TimeNs t_ns; double bias_rad, w; };
   std::complex<double> pdr_at(TimeNs t_ns) const;
+  void forget_before_window(TimeNs t_ns);  // positions and course samples older than window_s
   void fit();
 
   PdrCalibrationOptions opt_;
