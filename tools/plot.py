@@ -356,7 +356,7 @@ def plot_outage(args):
         if cal.get("valid"):
             sub = (f"\ncalibration before the window: scale {cal['scale']:.3f} +- {cal['scale_sigma']:.3f}, "
                    f"heading bias {cal['heading_bias_deg']:.1f} +- {cal['heading_bias_sigma_deg']:.1f} deg "
-                   f"({cal['window_epochs']} epochs, {cal['baseline_m']:.0f} m)"
+                   f"({cal.get('window_epochs', cal.get('epochs'))} epochs, {cal['baseline_m']:.0f} m)"
                    + (f"\nheading from the GNSS course over ground: {cal['course_bias_deg']:.1f} +- "
                       f"{cal['course_bias_sigma_deg']:.1f} deg ({cal['course_epochs']} epochs)"
                       if cal.get("course_epochs", 0) > 0 else ""))
