@@ -88,13 +88,23 @@ struct WalkResult {
 };
 
 /// "; course over ground B +- S deg (N epochs)" when the GNSS course (a Fix's bearing or a
-/// TDCP/Doppler displacement's direction) went into the heading.
+/// TDCP/Doppler displacement's direction) went into the heading, "; speed scale ..." when the
+/// GNSS speed went into the scale, "; positions not used (baseline)" when the fit lacked one.
 std::string course_note(const fusion::PdrCalibration& c) {
-  if (c.course_epochs <= 0 || !(c.course_bias_sigma_rad > 0.0)) return "";
+  std::string out;
   char b[128];
-  std::snprintf(b, sizeof b, "; course over ground %.1f +- %.1f deg (%d epochs)", rad_to_deg(c.course_bias_rad),
-                rad_to_deg(c.course_bias_sigma_rad), c.course_epochs);
-  return b;
+  if (c.course_epochs > 0 && c.course_bias_sigma_rad > 0.0) {
+    std::snprintf(b, sizeof b, "; course over ground %.1f +- %.1f deg (%d epochs)", rad_to_deg(c.course_bias_rad),
+                  rad_to_deg(c.course_bias_sigma_rad), c.course_epochs);
+    out += b;
+  }
+  if (c.speed_epochs > 0 && c.speed_scale_sigma > 0.0) {
+    std::snprintf(b, sizeof b, "; GNSS speed scale %.3f +- %.3f (%d epochs)", c.speed_scale, c.speed_scale_sigma,
+                  c.speed_epochs);
+    out += b;
+  }
+  if (c.valid && !c.positions_used) out += "; positions not used (baseline below the minimum)";
+  return out;
 }
 
 bool is_gnss(const Sample& s) { return std::holds_alternative<GnssRawSample>(s) || std::holds_alternative<FixSample>(s); }

@@ -71,6 +71,8 @@ struct EvalPdrArgs {
   double segment_min_m = 0.0;   // 0: a segment per Truth line (surveyed waypoints)
   double align_start_s = 0.0;   // 0: no alignment (absolute tracks)
   std::string json_out;         // one JSON object per walk, one per line
+  std::string reference = "auto";  // truth | fixes | auto (Truth lines when a log has 2+, else its fixes)
+  double fix_max_accuracy_m = 10.0;  // --reference fixes: fixes stating a worse 68 % accuracy are not scored
 };
 
 /// Whether a sample belongs to the sensor set (issue 27 "every sensor set"): accel =
@@ -129,6 +131,8 @@ class NaivePdr {
   std::int64_t steps_since_start() const { return steps_ - steps_at_start_; }
   const Eigen::Vector2d& pos_en() const { return pos_en_; }
   std::int64_t steps() const { return steps_; }
+  /// false when the log has no rotation vector: this baseline is then not defined (n/a)
+  bool has_yaw() const { return have_yaw_; }
   const std::vector<TimeNs>& step_times() const { return step_times_; }
 
  private:
@@ -152,6 +156,8 @@ struct WalkResult {
   std::map<std::string, std::string> meta;  // the log's Meta lines (latest value per key)
   std::vector<double> still_errors_m;       // "still": the estimate stays at the start
   std::int64_t naive_steps = 0;
+  std::string reference = "truth";        // what the walk was scored against (truth | fixes)
+  std::int64_t fixes_used = 0, fixes_rejected = 0;  // --reference fixes: scored / over the accuracy bound
   std::int64_t steps_in_truth_span = -1, naive_steps_in_truth_span = -1;  // -1: no Meta TruthStepsFrom/ToNanos
   double truth_path_m = kNaN, final_m = kNaN, naive_final_m = kNaN, still_final_m = kNaN;
   double rms_pct = kNaN, naive_rms_pct = kNaN, still_rms_pct = kNaN;  // RMS error / truth path, % (aligned)
@@ -392,10 +398,52 @@ std::vector<Sample> with_waving(const std::vector<Sample>& in, const EvalPdrArgs
   return out;
 }
 
+/// The phone's own fixes as the reference (a logger walk outdoors has no surveyed truth): each
+/// Fix row stating a 68 % accuracy <= --fix-max-accuracy-m becomes a Truth point, the others are
+/// counted and dropped; Truth lines already in the log are dropped (one reference per walk).
+std::vector<Sample> fixes_as_reference(const std::vector<Sample>& in, double max_accuracy_m, WalkResult& r) {
+  std::vector<Sample> out;
+  out.reserve(in.size());
+  for (const Sample& s : in) {
+    if (std::holds_alternative<TruthSample>(s)) continue;
+    const auto* f = std::get_if<FixSample>(&s);
+    if (!f) {
+      out.push_back(s);
+      continue;
+    }
+    if (!std::isfinite(f->lat_deg) || !std::isfinite(f->lon_deg) || !std::isfinite(f->accuracy_m) ||
+        f->accuracy_m > max_accuracy_m) {
+      ++r.fixes_rejected;
+      continue;
+    }
+    TruthSample t;
+    t.t_ns = f->t_ns;
+    t.lat_deg = f->lat_deg;
+    t.lon_deg = f->lon_deg;
+    t.h_m = f->alt_m;
+    out.push_back(t);
+    ++r.fixes_used;
+  }
+  return out;
+}
+
 WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   WalkResult r;
   r.name = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
   std::vector<Sample> samples = read_samples(path);
+  const auto truth_lines = std::count_if(samples.begin(), samples.end(),
+                                         [](const Sample& s) { return std::holds_alternative<TruthSample>(s); });
+  if (a.reference == "fixes" || (a.reference == "auto" && truth_lines < 2)) {
+    samples = fixes_as_reference(samples, a.fix_max_accuracy_m, r);
+    r.reference = "fixes";
+    if (r.fixes_used < 2)
+    {
+      std::ostringstream o;
+      o << path << ": fewer than 2 Truth lines and fewer than 2 fixes stating accuracy <= " << a.fix_max_accuracy_m
+        << " m (" << r.fixes_used << " such fixes, " << r.fixes_rejected << " worse or without accuracy): nothing to score";
+      throw std::runtime_error(o.str());
+    }
+  }
   TimeNs walk_start_ns = std::numeric_limits<TimeNs>::min();
   if (a.wave_s > 0.0) samples = with_waving(samples, a, path, &walk_start_ns);
   Runner run(a);
@@ -535,6 +583,11 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   };
   r.rms_pct = rms_pct(est_en, &r.align_deg);
   r.naive_rms_pct = rms_pct(naive_en, &r.naive_align_deg);
+  if (!naive.has_yaw()) {  // no rotation vector in the log: the naive PDR has no heading, n/a
+    r.naive_mean_m = r.naive_final_m = r.naive_ratio = r.naive_rms_pct = r.naive_align_deg = kNaN;
+    r.naive_seg_heading_err_deg.clear();
+    r.naive_steps = -1;  // its steps wait for a heading
+  }
   double sq = 0;
   for (double e : r.still_errors_m) sq += e * e;
   r.still_rms_pct = truth_len > 0 ? 100.0 * std::sqrt(sq / static_cast<double>(r.still_errors_m.size())) / truth_len : kNaN;
@@ -550,11 +603,17 @@ nlohmann::json walk_json(const WalkResult& r, const EvalPdrArgs& a) {
   j["walk"] = r.name;
   j["meta"] = r.meta;
   j["sensors"] = a.sensors;
+  j["reference"] = r.reference;
+  if (r.reference == "fixes") {
+    j["fixes_used"] = r.fixes_used;
+    j["fixes_rejected"] = r.fixes_rejected;
+    j["fix_max_accuracy_m"] = a.fix_max_accuracy_m;
+  }
   j["samples_dropped_by_sensor_set"] = r.samples_dropped_by_sensor_set;
   j["scored_points"] = r.errors_m.size();
   j["truth_path_m"] = num(r.truth_path_m);
   j["steps"] = r.steps;
-  j["naive_steps"] = r.naive_steps;
+  j["naive_steps"] = r.naive_steps >= 0 ? nlohmann::json(r.naive_steps) : nlohmann::json(nullptr);
   if (r.steps_in_truth_span >= 0) {
     j["steps_in_truth_span"] = r.steps_in_truth_span;
     j["naive_steps_in_truth_span"] = r.naive_steps_in_truth_span;
@@ -619,6 +678,9 @@ int run_eval_pdr(const EvalPdrArgs& a) {
                 r.name.c_str(), r.errors_m.size() + 1, static_cast<long long>(r.steps), r.mean_m,
                 *std::max_element(r.errors_m.begin(), r.errors_m.end()), r.length_ratio,
                 median(r.seg_heading_err_deg), r.naive_mean_m, r.naive_ratio);
+    if (r.reference == "fixes")
+      std::printf("    reference: the phone's fixes, %lld scored (accuracy <= %.1f m), %lld over the bound\n",
+                  static_cast<long long>(r.fixes_used), a.fix_max_accuracy_m, static_cast<long long>(r.fixes_rejected));
     if (a.wave_s > 0.0)
       std::printf("    waving_steps: %lld (naive %lld)\n", static_cast<long long>(r.waving_steps),
                   static_cast<long long>(r.naive_waving_steps));
@@ -673,7 +735,7 @@ int run_eval_pdr(const EvalPdrArgs& a) {
 
 void register_eval_pdr(CLI::App& app) {
   auto a = std::make_shared<EvalPdrArgs>();
-  CLI::App* c = app.add_subcommand("eval-pdr", "PDR on real walks with surveyed waypoints (Truth lines): errors per walk");
+  CLI::App* c = app.add_subcommand("eval-pdr", "PDR on real walks with surveyed waypoints (Truth lines) or the phone's fixes: errors per walk");
   c->add_option("logs", a->logs, "session logs with Truth lines (tools/ilc2log converts the ILC walks)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -711,6 +773,15 @@ void register_eval_pdr(CLI::App& app) {
   c->add_option("--align-start-s", a->align_start_s,
                 "rotate each track about the start to fit the truth over its first S seconds (RMS % metric; 0 = off)")
       ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
+  c->add_option("--reference", a->reference,
+                "truth (Truth lines) | fixes (the phone's Fix rows, e.g. a Sensor Logger walk outdoors) | auto "
+                "(Truth when a log has 2 or more lines, else fixes)")
+      ->check(CLI::IsMember({"truth", "fixes", "auto"}))
+      ->capture_default_str();
+  c->add_option("--fix-max-accuracy-m", a->fix_max_accuracy_m,
+                "with fixes as the reference: score only fixes stating this 68 % accuracy or better")
+      ->check(CLI::Range(0.5, 1000.0))
       ->capture_default_str();
   c->add_option("--json", a->json_out, "write one JSON object per walk (one per line) to this file");
   c->add_flag("--legacy", a->legacy,

@@ -151,6 +151,7 @@ TEST(NavigatorFusionWalk, TheFixesCourseOverGroundCalibratesTheHeading) {
     ASSERT_TRUE(both.cal.valid) << seed;
     EXPECT_EQ(pos.cal.course_epochs, 0) << seed;
     EXPECT_GT(both.cal.course_epochs, 100) << seed;
+    EXPECT_EQ(both.cal.speed_epochs, 0) << seed;  // a Fix's speed is not a scale sample (fix_speed_scale)
     EXPECT_NEAR(rad_to_deg(both.cal.heading_bias_rad), rad_to_deg(clean.cal.heading_bias_rad), 1.0) << seed;
     EXPECT_LT(both.fused_err_end_outage_m, pos.fused_err_end_outage_m) << seed;
     EXPECT_LE(both.max_jump_sigma, 3.0) << seed;

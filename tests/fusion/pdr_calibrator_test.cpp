@@ -31,9 +31,16 @@ struct CourseFeed {
   double wander_rad = 4.0 * kDegToRad, noise_rad = 10.0 * kDegToRad;
 };
 
+/// The GNSS speed fed beside the positions (TDCP/Doppler): none, or the walker's speed over the
+/// last step plus a slow wander and uniform noise (not the calibrator's Gaussian model).
+struct SpeedFeed {
+  bool on = false;
+  double wander_mps = 0.05, noise_mps = 0.15;
+};
+
 PdrCalibration run(const Walk& w, double minutes, std::uint64_t seed, double multipath_m = 3.0,
-                   const CourseFeed& course = {}, PdrCalibration* last = nullptr) {
-  std::mt19937_64 rng(seed);
+                   const CourseFeed& course = {}, PdrCalibration* last = nullptr, const SpeedFeed& speed = {}) {
+  std::mt19937_64 rng(seed), speed_rng(seed + 1000);  // (the speed's own draws: the same walk with or without it)
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::exponential_distribution<double> expo(1.0);
   auto laplace = [&](double b) { return (u(rng) > 0 ? 1.0 : -1.0) * b * expo(rng); };
@@ -70,6 +77,11 @@ PdrCalibration run(const Walk& w, double minutes, std::uint64_t seed, double mul
         cal.add_course(next_gnss, h + course.wander_rad * std::sin(2 * kPi * tg / 83.0 + ph2) + course.noise_rad * u(rng),
                        1.36, std::nan(""));
       }
+      if (speed.on)
+        cal.add_speed(next_gnss,
+                      true_len / (static_cast<double>(step_ns) * 1e-9) + speed.wander_mps * std::sin(2 * kPi * tg / 61.0 + ph1) +
+                          speed.noise_mps * u(speed_rng),
+                      0.1);
       cal.add_gnss(next_gnss, Eigen::Vector2d(e, n) + err, 4.0);
       next_gnss += kNsPerS;
     }
@@ -158,6 +170,40 @@ TEST(PdrCalibrator, CourseOverGroundPinsTheHeadingBiasWhenPositionsCannot) {
   }
 }
 
+// The GNSS speed (TDCP/Doppler) against the PDR speed is a step-scale sample that needs no
+// baseline: 45 s of walking (one straight ~40 m leg and a turn; the position fit's baseline is
+// below its 20 m) already publish the scale, within its stated 3 sigma of the truth; without the
+// speed nothing is published. Over five minutes it tightens the position fit's scale.
+TEST(PdrCalibrator, GnssSpeedPublishesTheScaleBeforeThePositionsCan) {
+  Walk w;
+  w.true_scale = 1.3;  // a walker whose steps are 30 % longer than the model's (the shared ETH walk)
+  SpeedFeed sp;
+  sp.on = true;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    PdrCalibration pos_last;
+    const PdrCalibration pos = run(w, 0.75, seed, 3.0, CourseFeed{}, &pos_last);
+    const PdrCalibration both = run(w, 0.75, seed, 3.0, CourseFeed{}, nullptr, sp);
+    std::printf("seed %d: 45 s, positions (baseline %.1f m) %s; with speed %.3f +- %.3f (%d samples)\n", static_cast<int>(seed),
+                pos_last.baseline_m, pos.valid ? "published" : "not published", both.scale, both.scale_sigma,
+                both.speed_epochs);
+    EXPECT_FALSE(pos.valid) << seed;
+    ASSERT_TRUE(both.valid) << seed;
+    EXPECT_FALSE(both.positions_used) << seed;
+    EXPECT_GE(both.speed_epochs, 10) << seed;
+    EXPECT_LT(both.scale_sigma, 0.10) << seed;  // well inside the filter's 15 % prior
+    EXPECT_LT(std::abs(both.scale - w.true_scale), 3.0 * both.scale_sigma) << seed;
+    EXPECT_FALSE(both.heading_applied) << seed;  // the speed says nothing of the heading
+  }
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    const PdrCalibration pos = run(w, 5.0, seed);
+    const PdrCalibration both = run(w, 5.0, seed, 3.0, CourseFeed{}, nullptr, sp);
+    ASSERT_TRUE(pos.valid && both.valid) << seed;
+    EXPECT_TRUE(both.positions_used) << seed;
+    EXPECT_LT(both.scale_sigma, pos.scale_sigma) << seed;
+    EXPECT_NEAR(both.scale, w.true_scale, 0.02 * w.true_scale) << seed;
+  }
+}
+
 TEST(PdrCalibrator, SlowCourseSamplesAreNotUsed) {
   PdrCalibrator cal;
   for (int k = 0; k < 200; ++k) {
@@ -166,10 +212,14 @@ TEST(PdrCalibrator, SlowCourseSamplesAreNotUsed) {
     s.length_m = 0.7;
     s.heading_rad = 0.5;
     cal.add_step(s);
-    if (k % 2 == 0) cal.add_course(s.t_ns, 2.0, 0.3, std::nan(""));  // standing / shuffling: no direction
+    if (k % 2 == 0) {  // standing / shuffling: no direction, no speed to compare
+      cal.add_course(s.t_ns, 2.0, 0.3, std::nan(""));
+      cal.add_speed(s.t_ns, 0.3, 0.05);
+    }
   }
   for (int k = 0; k < 100; ++k) cal.add_gnss(k * kNsPerS, Eigen::Vector2d(0.7 * std::sin(0.5) * 2 * k, 0.7 * std::cos(0.5) * 2 * k), 3.0);
   EXPECT_EQ(cal.calibration().course_epochs, 0);
+  EXPECT_EQ(cal.calibration().speed_epochs, 0);
 }
 
 // After an outage of the course (e.g. GNSS lost, positions back first) the old samples leave

@@ -92,10 +92,16 @@ add_test(NAME pdr_cli_tyrex_convert
 set_tests_properties(pdr_cli_tyrex_convert PROPERTIES LABELS "pdr;cli" FIXTURES_SETUP pdr_tyrex
                      PASS_REGULAR_EXPRESSION "carry running pocket +disturbance none +truth_steps +(29[0-9]|3[0-2][0-9]) cadence 2\\.[6-8][0-9] Hz.*carry texting +disturbance none +truth_steps +(8[5-9]|9[0-9]|10[0-9]) cadence 1\\.[0-2][0-9] Hz truth_lines [0-9]+ steps_span [3-9]\\.[0-9]-12[0-9]\\.[0-9] s of [0-9.]+-[0-9.]+ s.*converted 2 of 2 recordings")
 add_test(NAME pdr_cli_eval_pdr_all
-         COMMAND /usr/bin/python3 "${PROJECT_SOURCE_DIR}/tools/eval-pdr-all" --sets tyrex,oxford --no-convert
+         COMMAND /usr/bin/python3 "${PROJECT_SOURCE_DIR}/tools/eval-pdr-all" --sets tyrex,oxford,outdoor --no-convert
                  --out "${_pdr_tyrex_out}" --pdnav $<TARGET_FILE:pdnav> --data "${PDNAV_SHARED_DATA_DIR}")
 set_tests_properties(pdr_cli_eval_pdr_all PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
-                     PASS_REGULAR_EXPRESSION "running pocket/none +1 .*texting/none +1 .*summary tyrex sensors=all: walks 2 median_mean_error_m [0-7]\\.[0-9]+ median_rms_pct [0-9.]+ .* median_step_error_pct ([0-9]|[12][0-9])\\.[0-9] .* beats_naive [0-2] beats_still [0-2] naive_median_mean_error_m [0-9.]+ still_median_mean_error_m [0-9.]+\n.*summary oxford: walks 6 mean_step_error_pct 0\\.[0-9]+ worst_step_error_pct [0-2]\\.[0-9]+ ")
+                     PASS_REGULAR_EXPRESSION "running pocket/none +1 .*texting/none +1 .*summary tyrex sensors=all: walks 2 median_mean_error_m [0-7]\\.[0-9]+ median_rms_pct [0-9.]+ .* median_step_error_pct ([0-9]|[12][0-9])\\.[0-9] .* beats_naive [0-2] beats_still [0-2] naive_median_mean_error_m [0-9.]+ still_median_mean_error_m [0-9.]+\n.*summary outdoor sensors=all: walks 1 median_mean_error_m [2-6][0-9]\\.[0-9]+ median_rms_pct [0-9.]+ median_seg_heading_abs_deg [0-9]\\.[0-9] .* median_length_ratio 0\\.[6-9][0-9]+ .* naive_median_mean_error_m - still_median_mean_error_m 1[0-9][0-9]\\.[0-9]+\n.*summary oxford: walks 6 mean_step_error_pct 0\\.[0-9]+ worst_step_error_pct [0-2]\\.[0-9]+ ")
+# --reference fixes on a log without Fix rows (a TYREX recording): a clear error, exit 1
+add_test(NAME pdr_cli_eval_pdr_no_fixes
+         COMMAND sh -c "$0 eval-pdr --reference fixes \"$1\" 2>&1; echo rc=$?" $<TARGET_FILE:pdnav>
+                 "${_pdr_tyrex_out}/logs/tyrex/Guillaume_Nexus5_NoDist_Texting.log")
+set_tests_properties(pdr_cli_eval_pdr_no_fixes PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
+                     PASS_REGULAR_EXPRESSION "Guillaume_Nexus5_NoDist_Texting\\.log: fewer than 2 Truth lines and fewer than 2 fixes stating accuracy <= 10 m \\(0 such fixes, 0 worse or without accuracy\\): nothing to score.*no walk could be evaluated.*rc=1")
 # tools/tyrex2log on bad input: a recording whose accelerometer file has a short line and a
 # non-number (skipped, counted, file:line on stderr) converts; one without its motion-capture
 # file is an error with its path, and the run says 1 of 2 converted (exit 1).

@@ -269,7 +269,11 @@ nlohmann::json pdr_calibration_json(const fusion::PdrCalibration& c) {
           {"residual_rho", c.residual_rho},
           {"course_epochs", c.course_epochs},
           {"course_bias_deg", rad_to_deg(c.course_bias_rad)},
-          {"course_bias_sigma_deg", rad_to_deg(c.course_bias_sigma_rad)}};
+          {"course_bias_sigma_deg", rad_to_deg(c.course_bias_sigma_rad)},
+          {"speed_epochs", c.speed_epochs},
+          {"speed_scale", c.speed_scale},
+          {"speed_scale_sigma", c.speed_scale_sigma},
+          {"positions_used", c.positions_used}};
 }
 
 nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_steps, TimeNs t0_ns) {

@@ -65,6 +65,7 @@ FusionOptions fusion_options_before_issue28() {
   o.calibration.check_bias_drift = false;
   o.calibration.independent_heading = false;
   o.calibration.use_course = false;
+  o.calibration.use_speed = false;
   return o;
 }
 
@@ -523,10 +524,13 @@ struct Navigator::Impl {
       double nis = 0.0;
       if (ff.update_displacement(t, t - ns(sol.disp_dt_s), sol.tdcp_disp_m.head<2>(), sd * sd * Eigen::Matrix2d::Identity(), &nis)) {
         ++counts["GNSS: " + sol.disp_source + " displacement used"];
-        // its direction is the course over ground since the last epoch: a heading-bias sample
+        // its direction is the course over ground since the last epoch, its length the distance:
+        // a heading-bias and a step-scale sample
         const Eigen::Vector2d d = sol.tdcp_disp_m.head<2>();
-        if (d.norm() > 0.0)
+        if (d.norm() > 0.0) {
           cal.add_course(t, std::atan2(d.x(), d.y()), d.norm() / sol.disp_dt_s, std::atan2(sd, d.norm()));
+          cal.add_speed(t, d.norm() / sol.disp_dt_s, sd / sol.disp_dt_s);
+        }
       }
       else if (ff.clone_t_ns() >= 0)
         ++counts["GNSS: " + sol.disp_source + " displacement rejected or unmatched"];
@@ -587,9 +591,11 @@ struct Navigator::Impl {
     if (r.accepted) {
       if (std::isfinite(f.alt_m)) height_m = f.alt_m;
       // the fix's course over ground (Doppler velocity): a heading-bias sample for the calibrator.
-      // Exactly 0 is Android's Location.getBearing() without hasBearing() (loggers write it so)
+      // Exactly 0 is Android's Location.getBearing() without hasBearing() (loggers write it so).
+      // Its speed is a step-scale sample only with fix_speed_scale (see NavigatorOptions)
       if (std::isfinite(f.bearing_deg) && f.bearing_deg != 0.0 && std::isfinite(f.speed_mps))
         cal.add_course(f.t_ns, f.bearing_deg * kDegToRad, f.speed_mps, f.bearing_accuracy_deg * kDegToRad);
+      if (fo().fix_speed_scale) cal.add_speed(f.t_ns, f.speed_mps, f.speed_accuracy_mps);
       accepted_gnss(f.t_ns, z, sigma, true, "chipset Fix, accuracy " + fmt(acc) + " m");
       if (r.reacquired) refresh_mode(f.t_ns, "Fix " + r.reason);
     }

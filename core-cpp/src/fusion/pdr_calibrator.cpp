@@ -44,6 +44,25 @@ void PdrCalibrator::forget_before_window(TimeNs t_ns) {
   const TimeNs start_ns = t_ns - static_cast<TimeNs>(opt_.window_s * 1e9);
   while (!window_.empty() && window_.front().t_ns < start_ns) window_.pop_front();
   while (!courses_.empty() && courses_.front().t_ns < start_ns) courses_.pop_front();
+  while (!speeds_.empty() && speeds_.front().t_ns < start_ns) speeds_.pop_front();
+}
+
+bool PdrCalibrator::straight_span(TimeNs t_ns, std::complex<double>* net, double* path_m, int* steps) const {
+  const TimeNs from_ns = t_ns - static_cast<TimeNs>(opt_.course_pdr_span_s * 1e9);
+  if (steps_.empty() || steps_.front().first > from_ns) return false;  // the PDR path before t_ns is not kept
+  std::complex<double> prev = pdr_at(from_ns);
+  *net = pdr_at(t_ns) - prev;
+  *path_m = 0.0;
+  *steps = 0;
+  for (const auto& [t, z] : steps_) {
+    if (t <= from_ns) continue;
+    if (t > t_ns) break;
+    *path_m += std::abs(z - prev);
+    prev = z;
+    ++*steps;
+  }
+  // a turn inside the span, or no step in it: the PDR and GNSS velocities are not comparable
+  return *path_m > 0.0 && std::abs(*net) >= opt_.course_min_straightness * *path_m;
 }
 
 // The course sample: with the PDR direction h (clockwise from north) over the straight path
@@ -51,19 +70,10 @@ void PdrCalibrator::forget_before_window(TimeNs t_ns) {
 void PdrCalibrator::add_course(TimeNs t_ns, double course_rad, double speed_mps, double sigma_rad) {
   if (!opt_.use_course || !std::isfinite(course_rad) || !std::isfinite(speed_mps) || speed_mps < opt_.course_min_speed_mps)
     return;
-  const TimeNs from_ns = t_ns - static_cast<TimeNs>(opt_.course_pdr_span_s * 1e9);
-  if (steps_.empty() || steps_.front().first > from_ns) return;  // the PDR path before t_ns is not kept
-  std::complex<double> prev = pdr_at(from_ns);
-  const std::complex<double> net = pdr_at(t_ns) - prev;
+  std::complex<double> net;
   double path = 0.0;
-  for (const auto& [t, z] : steps_) {
-    if (t <= from_ns) continue;
-    if (t > t_ns) break;
-    path += std::abs(z - prev);
-    prev = z;
-  }
-  // a turn inside the span, or no step in it: the two directions are not comparable
-  if (!(path > 0.0) || std::abs(net) < opt_.course_min_straightness * path) return;
+  int steps = 0;
+  if (!straight_span(t_ns, &net, &path, &steps)) return;
   const double pdr_heading = 0.5 * kPi - std::arg(net);
   const double sigma = std::isfinite(sigma_rad) && sigma_rad > 0.0
                            ? sigma_rad
@@ -72,10 +82,26 @@ void PdrCalibrator::add_course(TimeNs t_ns, double course_rad, double speed_mps,
   forget_before_window(t_ns);
 }
 
+// The speed sample: the GNSS speed over the same straight span against the PDR path in it, as a
+// log step scale (true length = scale x PDR length); its sigma from the speed's and from the
+// whole steps a fixed span holds (uniform +-1/2 step: 1/sqrt(12) step).
+void PdrCalibrator::add_speed(TimeNs t_ns, double speed_mps, double sigma_mps) {
+  if (!opt_.use_speed || !std::isfinite(speed_mps) || speed_mps < opt_.course_min_speed_mps) return;
+  std::complex<double> net;
+  double path = 0.0;
+  int steps = 0;
+  if (!straight_span(t_ns, &net, &path, &steps)) return;
+  const double sv = std::isfinite(sigma_mps) && sigma_mps > 0.0 ? sigma_mps : opt_.course_velocity_sigma_mps;
+  const double sigma_log = std::hypot(sv / speed_mps, 1.0 / std::sqrt(12.0) / steps);
+  speeds_.push_back({t_ns, std::log(speed_mps * opt_.course_pdr_span_s / path), 1.0 / (sigma_log * sigma_log)});
+  forget_before_window(t_ns);
+}
+
 void PdrCalibrator::reset() {
   steps_.clear();
   window_.clear();
   courses_.clear();
+  speeds_.clear();
   last_ = PdrCalibration{};
   published_ = PdrCalibration{};
 }
@@ -107,30 +133,32 @@ double account_for_drift(double a_rad, double a_var, double b_rad, double b_var,
   return drift;
 }
 
-struct CourseFit {
+struct SeriesFit {
   bool ok = false;
-  double bias_rad = 0.0, var_rad2 = 0.0;
+  double mean = 0.0, var = 0.0;
 };
 
-/// Weighted circular mean of the course samples over [b, e), its variance inflated like the
-/// position fit's (residual variance factor, effective number of samples).
+/// Weighted mean (circular for angles: the course samples; linear: the log speed scales) of the
+/// samples over [b, e), its variance inflated like the position fit's (residual variance
+/// factor, effective number of samples).
 template <typename It>
-CourseFit fit_courses(It b, It e, const PdrCalibrationOptions& opt) {
-  CourseFit f;
+SeriesFit fit_series(It b, It e, const PdrCalibrationOptions& opt, bool circular) {
+  SeriesFit f;
   const double n = static_cast<double>(std::distance(b, e));
   if (n < 2) return f;
   std::complex<double> sum = 0.0;
-  double w_sum = 0.0, moving_s = 0.0;
+  double w_sum = 0.0, moving_s = 0.0, lin = 0.0;
   for (It x = b; x != e; ++x) {
-    sum += x->w * std::polar(1.0, x->bias_rad);
+    sum += x->w * std::polar(1.0, x->value);
+    lin += x->w * x->value;
     w_sum += x->w;
     // a gap (standing, a turn) counts as at most one correlation time
     if (x != b) moving_s += std::min(opt.correlation_time_s, static_cast<double>(x->t_ns - std::prev(x)->t_ns) * 1e-9);
   }
-  f.bias_rad = std::arg(sum);
+  f.mean = circular ? std::arg(sum) : lin / w_sum;
   double chi2 = 0.0, r0 = 0.0, r1 = 0.0, prev = 0.0;
   for (It x = b; x != e; ++x) {
-    const double r = std::remainder(x->bias_rad - f.bias_rad, 2.0 * kPi);
+    const double r = circular ? std::remainder(x->value - f.mean, 2.0 * kPi) : x->value - f.mean;
     chi2 += x->w * r * r;
     r0 += r * r;
     if (x != b) r1 += prev * r;
@@ -138,7 +166,7 @@ CourseFit fit_courses(It b, It e, const PdrCalibrationOptions& opt) {
   }
   const double rho = r0 > 0.0 ? std::clamp(r1 / r0, 0.0, 0.999) : 0.0;
   const double var_factor = std::max(1.0, chi2 / (n - 1.0));
-  f.var_rad2 = var_factor / w_sum * (n / effective_samples(n, moving_s, rho, opt));
+  f.var = var_factor / w_sum * (n / effective_samples(n, moving_s, rho, opt));
   f.ok = true;
   return f;
 }
@@ -210,57 +238,91 @@ void PdrCalibrator::fit() {
   c.baseline_m = f.baseline_m;
   c.span_s = f.span_s;
   c.residual_rho = f.rho;
-  if (!f.ok) { last_ = c; return; }
-  const std::complex<double> gain = f.gain;
-  const double var_component = f.var_component;
-  c.scale = std::abs(gain);
-  c.heading_bias_rad = std::arg(gain);
-  c.scale_sigma = std::sqrt(var_component);
-  c.heading_bias_sigma_rad = c.scale > 0.0 ? std::sqrt(var_component) / c.scale : kPi;
-  // Did the bias stay put over the window? Fit the two halves of the PDR path separately
-  // (account_for_drift); the movement is published as heading_bias_drift_sigma_rad.
-  if (opt_.check_bias_drift && window_.size() >= 6) {
-    double path = 0.0;
-    for (std::size_t i = 1; i < window_.size(); ++i) path += std::abs(window_[i].p - window_[i - 1].p);
-    double acc = 0.0;
-    std::size_t mid = 1;
-    for (; mid < window_.size(); ++mid) {
-      acc += std::abs(window_[mid].p - window_[mid - 1].p);
-      if (acc >= 0.5 * path) break;
+  if (f.ok) {
+    const std::complex<double> gain = f.gain;
+    const double var_component = f.var_component;
+    c.scale = std::abs(gain);
+    c.heading_bias_rad = std::arg(gain);
+    c.scale_sigma = std::sqrt(var_component);
+    c.heading_bias_sigma_rad = c.scale > 0.0 ? std::sqrt(var_component) / c.scale : kPi;
+    // Did the bias stay put over the window? Fit the two halves of the PDR path separately
+    // (account_for_drift); the movement is published as heading_bias_drift_sigma_rad.
+    if (opt_.check_bias_drift && window_.size() >= 6) {
+      double path = 0.0;
+      for (std::size_t i = 1; i < window_.size(); ++i) path += std::abs(window_[i].p - window_[i - 1].p);
+      double acc = 0.0;
+      std::size_t mid = 1;
+      for (; mid < window_.size(); ++mid) {
+        acc += std::abs(window_[mid].p - window_[mid - 1].p);
+        if (acc >= 0.5 * path) break;
+      }
+      const auto m = window_.begin() + static_cast<std::ptrdiff_t>(std::clamp<std::size_t>(mid, 3, window_.size() - 3));
+      const RangeFit a = fit_range(window_.begin(), m, opt_), b = fit_range(m, window_.end(), opt_);
+      if (a.ok && b.ok && std::abs(a.gain) > 0.0 && std::abs(b.gain) > 0.0)  // (the scale stays the whole window's)
+        c.heading_bias_drift_sigma_rad =
+            account_for_drift(std::arg(a.gain), a.var_component / std::norm(a.gain), std::arg(b.gain),
+                              b.var_component / std::norm(b.gain), &c.heading_bias_rad, &c.heading_bias_sigma_rad);
     }
-    const auto m = window_.begin() + static_cast<std::ptrdiff_t>(std::clamp<std::size_t>(mid, 3, window_.size() - 3));
-    const RangeFit a = fit_range(window_.begin(), m, opt_), b = fit_range(m, window_.end(), opt_);
-    if (a.ok && b.ok && std::abs(a.gain) > 0.0 && std::abs(b.gain) > 0.0)  // (the scale stays the whole window's)
-      c.heading_bias_drift_sigma_rad =
-          account_for_drift(std::arg(a.gain), a.var_component / std::norm(a.gain), std::arg(b.gain),
-                            b.var_component / std::norm(b.gain), &c.heading_bias_rad, &c.heading_bias_sigma_rad);
   }
+  // The position fit says something only over a baseline; the course and speed samples (GNSS
+  // velocity against the PDR over the same straight span) need none.
+  c.positions_used = f.ok && c.baseline_m >= opt_.min_baseline_m;
+  bool have_heading = c.positions_used && c.heading_bias_sigma_rad > 0.0;
+  bool have_scale = c.positions_used && c.scale_sigma > 0.0;
   // The GNSS course: a second, independent sample of the heading bias (Doppler velocity, not
   // positions), with the same drift check over its two halves; inverse-variance combined.
   c.course_epochs = static_cast<int>(courses_.size());
   if (opt_.use_course && c.course_epochs >= opt_.course_min_epochs) {
-    const CourseFit k = fit_courses(courses_.begin(), courses_.end(), opt_);
-    double kb = k.bias_rad, ks = std::sqrt(k.var_rad2);
+    const SeriesFit k = fit_series(courses_.begin(), courses_.end(), opt_, true);
+    double kb = k.mean, ks = std::sqrt(k.var);
     if (opt_.check_bias_drift && courses_.size() >= 6) {
       const auto m = courses_.begin() + static_cast<std::ptrdiff_t>(courses_.size() / 2);
-      const CourseFit a = fit_courses(courses_.begin(), m, opt_), b = fit_courses(m, courses_.end(), opt_);
-      if (a.ok && b.ok) account_for_drift(a.bias_rad, a.var_rad2, b.bias_rad, b.var_rad2, &kb, &ks);
+      const SeriesFit a = fit_series(courses_.begin(), m, opt_, true), b = fit_series(m, courses_.end(), opt_, true);
+      if (a.ok && b.ok) account_for_drift(a.mean, a.var, b.mean, b.var, &kb, &ks);
     }
-    if (k.ok && ks > 0.0 && c.heading_bias_sigma_rad > 0.0) {
+    if (k.ok && ks > 0.0) {
       c.course_bias_rad = kb;
       c.course_bias_sigma_rad = ks;
-      const double wp = 1.0 / (c.heading_bias_sigma_rad * c.heading_bias_sigma_rad), wk = 1.0 / (ks * ks);
-      c.heading_bias_rad = std::remainder(c.heading_bias_rad + std::remainder(kb - c.heading_bias_rad, 2.0 * kPi) * wk / (wp + wk), 2.0 * kPi);
-      c.heading_bias_sigma_rad = 1.0 / std::sqrt(wp + wk);
+      if (have_heading) {
+        const double wp = 1.0 / (c.heading_bias_sigma_rad * c.heading_bias_sigma_rad), wk = 1.0 / (ks * ks);
+        c.heading_bias_rad = std::remainder(c.heading_bias_rad + std::remainder(kb - c.heading_bias_rad, 2.0 * kPi) * wk / (wp + wk), 2.0 * kPi);
+        c.heading_bias_sigma_rad = 1.0 / std::sqrt(wp + wk);
+      } else {
+        c.heading_bias_rad = kb;
+        c.heading_bias_sigma_rad = ks;
+      }
+      have_heading = true;
     }
+  }
+  // The GNSS speed: a sample of the step scale, combined the same way (in the scale itself;
+  // its log-normal sigma is small enough to be taken as Gaussian there).
+  c.speed_epochs = static_cast<int>(speeds_.size());
+  if (opt_.use_speed && c.speed_epochs >= opt_.course_min_epochs) {
+    const SeriesFit v = fit_series(speeds_.begin(), speeds_.end(), opt_, false);
+    if (v.ok && v.var > 0.0) {
+      c.speed_scale = std::exp(v.mean);
+      c.speed_scale_sigma = c.speed_scale * std::sqrt(v.var);
+      if (have_scale) {
+        const double wp = 1.0 / (c.scale_sigma * c.scale_sigma), wv = 1.0 / (c.speed_scale_sigma * c.speed_scale_sigma);
+        c.scale = (wp * c.scale + wv * c.speed_scale) / (wp + wv);
+        c.scale_sigma = 1.0 / std::sqrt(wp + wv);
+      } else {
+        c.scale = c.speed_scale;
+        c.scale_sigma = c.speed_scale_sigma;
+      }
+      have_scale = true;
+    }
+  }
+  if (!have_heading) {  // nothing measured it: the prior (not applied below)
+    c.heading_bias_rad = 0.0;
+    c.heading_bias_sigma_rad = std::max(c.heading_bias_sigma_rad, opt_.prior_heading_bias_sigma_rad);
   }
   // Scale and heading bias are published independently: a heading fit that does not know the
   // bias to max_heading_bias_sigma_rad is not applied (bias 0, the filter keeps its prior
   // uncertainty, prior_heading_bias_sigma_rad) while a good scale still is.
-  c.heading_applied = c.heading_bias_sigma_rad <= opt_.max_heading_bias_sigma_rad;
-  c.valid = c.epochs >= opt_.min_epochs && c.baseline_m >= opt_.min_baseline_m && c.scale >= opt_.min_scale &&
-            c.scale <= opt_.max_scale && c.scale_sigma <= opt_.max_scale_sigma &&
-            (opt_.independent_heading || c.heading_applied);
+  c.heading_applied = have_heading && c.heading_bias_sigma_rad <= opt_.max_heading_bias_sigma_rad;
+  c.valid = c.epochs >= opt_.min_epochs && have_scale && c.scale >= opt_.min_scale && c.scale <= opt_.max_scale &&
+            c.scale_sigma <= opt_.max_scale_sigma && (opt_.independent_heading || c.heading_applied);
   if (c.valid && !c.heading_applied) {
     c.heading_bias_rad = 0.0;
     c.heading_bias_sigma_rad = std::max(c.heading_bias_sigma_rad, opt_.prior_heading_bias_sigma_rad);

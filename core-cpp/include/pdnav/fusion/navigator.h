@@ -59,6 +59,12 @@ struct FusionOptions {
   double fix_sigma_scale = 1.5;
   double fix_default_accuracy_m = 15.0;
   double fix_fallback_after_s = 3.0;
+  /// A Fix's speed as a step-scale sample (PdrCalibrator::add_speed). Off: a Fix is the
+  /// chipset's or the fused location provider's filtered output (Android's FLP also uses the
+  /// phone's motion sensors), and on the shared ETH walk its speed runs below the fixes' own
+  /// displacement (20 s windows: median ratio 1.04, up to 1.3; docs/fusion.md). The speed of
+  /// the GNSS engine's own TDCP/Doppler displacement is always used.
+  bool fix_speed_scale = false;
   /// Flush a pending GNSS epoch when another sensor's sample is this much later (an epoch is
   /// used when it is complete, not when the next one starts).
   double gnss_flush_after_s = 0.5;

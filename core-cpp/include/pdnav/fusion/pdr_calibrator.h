@@ -46,6 +46,13 @@ struct PdrCalibrationOptions {
   double course_pdr_span_s = 3.0;         // the PDR direction is taken over this span before the fix
   double course_min_straightness = 0.9;   // and only where that path is straight (net / path length)
   int course_min_epochs = 10;             // course samples in the window before they are used
+  /// The GNSS speed (Doppler: Location speed, TDCP/Doppler displacement) against the PDR speed
+  /// over the same straight span is a direct sample of the step scale, as the course is of the
+  /// heading bias: log(v_gnss * span / PDR path), 1-sigma from the speed's error and the step
+  /// count's quantisation (1/sqrt(12) step of the steps in the span). It needs no baseline, so
+  /// a calibration is published on a short straight walk where the position fit cannot be;
+  /// combined with the position fit's scale by inverse variance.
+  bool use_speed = true;
   std::size_t max_steps_kept = 4096;  // bound on the step history (memory)
 };
 
@@ -67,6 +74,10 @@ struct PdrCalibration {
   int course_epochs = 0;              // course samples in the window (0: heading from positions only)
   double course_bias_rad = 0.0;       // their heading bias, before combining with the position fit's
   double course_bias_sigma_rad = 0.0;
+  int speed_epochs = 0;               // speed samples in the window (0: scale from positions only)
+  double speed_scale = 1.0;           // their step scale, before combining with the position fit's
+  double speed_scale_sigma = 0.0;
+  bool positions_used = false;        // the position fit entered (its baseline reached min_baseline_m)
 };
 
 class PdrCalibrator {
@@ -78,9 +89,12 @@ class PdrCalibrator {
   /// paired with the PDR track at the same time (steps after t_ns are not counted).
   void add_gnss(TimeNs t_ns, const Eigen::Vector2d& en_m, double sigma_m);
   /// The GNSS course over ground at t_ns (clockwise from north) and speed, with the course's
-  /// 1-sigma if the receiver states one (NaN or <= 0: from the speed, course_velocity_sigma_mps). Call
-  /// before add_gnss of the same epoch; a slow or turning epoch is not used.
+  /// 1-sigma if the receiver states one (NaN or <= 0: from the speed, course_velocity_sigma_mps).
+  /// Call before add_gnss of the same epoch; a slow or turning epoch is not used.
   void add_course(TimeNs t_ns, double course_rad, double speed_mps, double sigma_rad);
+  /// The GNSS speed at t_ns with its 1-sigma (NaN or <= 0: course_velocity_sigma_mps): a
+  /// step-scale sample under the same conditions as add_course.
+  void add_speed(TimeNs t_ns, double speed_mps, double sigma_mps);
   /// Forget everything (e.g. the user changed the phone's placement).
   void reset();
   /// The latest fit (valid only once it passes the publication checks).
@@ -91,16 +105,19 @@ class PdrCalibrator {
 
  private:
   struct Pair { TimeNs t_ns; std::complex<double> p, g; double w; };
-  struct Course { TimeNs t_ns; double bias_rad, w; };
+  struct Series { TimeNs t_ns; double value, w; };  // a course (bias, rad) or speed (log scale) sample
   std::complex<double> pdr_at(TimeNs t_ns) const;
-  void forget_before_window(TimeNs t_ns);  // positions and course samples older than window_s
+  /// The raw PDR path over the course_pdr_span_s before t_ns: net displacement, path length and
+  /// steps; false where that path is not kept, has no step or is not straight.
+  bool straight_span(TimeNs t_ns, std::complex<double>* net, double* path_m, int* steps) const;
+  void forget_before_window(TimeNs t_ns);  // positions, course and speed samples older than window_s
   void fit();
 
   PdrCalibrationOptions opt_;
   std::complex<double> track_ = 0.0;                       // integrated raw PDR position
   std::deque<std::pair<TimeNs, std::complex<double>>> steps_;  // (t, track after the step)
   std::deque<Pair> window_;
-  std::deque<Course> courses_;
+  std::deque<Series> courses_, speeds_;
   PdrCalibration last_, published_;
 };
 
