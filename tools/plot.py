@@ -359,7 +359,9 @@ def plot_outage(args):
                    f"({cal.get('window_epochs', cal.get('epochs'))} epochs, {cal['baseline_m']:.0f} m)"
                    + (f"\nheading from the GNSS course over ground: {cal['course_bias_deg']:.1f} +- "
                       f"{cal['course_bias_sigma_deg']:.1f} deg ({cal['course_epochs']} epochs)"
-                      if cal.get("course_epochs", 0) > 0 else ""))
+                      if cal.get("course_epochs", 0) > 0 else "")
+                   + (f"\nscale from the GNSS speed: {cal['speed_scale']:.3f} +- {cal['speed_scale_sigma']:.3f} "
+                      f"({cal['speed_epochs']} epochs)" if cal.get("speed_epochs", 0) > 0 else ""))
         elif meta:
             sub = "\nno calibration published before the window"
         ax1.set_title((args.title or f"{stem}: GNSS outage cut into the recording") + sub, fontsize=10)
