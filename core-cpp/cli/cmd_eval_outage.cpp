@@ -90,7 +90,7 @@ struct WalkResult {
 /// "; course over ground B +- S deg (N epochs)" when the GNSS course (a Fix's bearing or a
 /// TDCP/Doppler displacement's direction) went into the heading, "; speed scale ..." when the
 /// GNSS speed went into the scale, "; positions not used (baseline)" when the fit lacked one.
-std::string course_note(const fusion::PdrCalibration& c) {
+std::string calibration_note(const fusion::PdrCalibration& c) {
   std::string out;
   char b[128];
   if (c.course_epochs > 0 && c.course_bias_sigma_rad > 0.0) {
@@ -108,12 +108,6 @@ std::string course_note(const fusion::PdrCalibration& c) {
 }
 
 bool is_gnss(const Sample& s) { return std::holds_alternative<GnssRawSample>(s) || std::holds_alternative<FixSample>(s); }
-
-bool is_gps_fix(const FixSample& f) {
-  std::string p = f.provider;
-  std::transform(p.begin(), p.end(), p.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
-  return p == "GPS" && std::isfinite(f.lat_deg) && std::isfinite(f.lon_deg);
-}
 
 double fix_sigma(const FixSample& f) {
   return (std::isfinite(f.accuracy_m) && f.accuracy_m > 0.0 ? f.accuracy_m : 15.0) * kAccuracyToSigma;
@@ -212,7 +206,7 @@ WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std:
     Sample s;
     while (reader.next(s)) {
       const TimeNs t = sample_time_ns(s);
-      if (const auto* f = std::get_if<FixSample>(&s); f && is_gps_fix(*f))
+      if (const auto* f = std::get_if<FixSample>(&s); f && is_gps_reference_fix(*f))
         fixes.push_back({t, geo::Geodetic::from_deg(f->lat_deg, f->lon_deg, 0.0), fix_sigma(*f)});
       if (const auto* tr = std::get_if<TruthSample>(&s); tr && std::isfinite(tr->lat_deg) && std::isfinite(tr->lon_deg))
         truth.push_back({t, geo::Geodetic::from_deg(tr->lat_deg, tr->lon_deg, 0.0), 0.0});
@@ -405,13 +399,13 @@ int run_eval_outage(const EvalOutageArgs& a) {
       std::printf("  calibration published before the window: scale %.3f +- %.3f, heading bias %.1f +- %.1f deg, %d epochs, "
                   "baseline %.0f m%s\n",
                   r.cal.scale, r.cal.scale_sigma, rad_to_deg(r.cal.heading_bias_rad), rad_to_deg(r.cal.heading_bias_sigma_rad),
-                  r.cal.epochs, r.cal.baseline_m, course_note(r.cal).c_str());
+                  r.cal.epochs, r.cal.baseline_m, calibration_note(r.cal).c_str());
     else
       std::printf("  calibration published before the window: none (uncalibrated PDR in the window); last fit: scale "
                   "%.3f +- %.3f, heading bias %.1f +- %.1f deg, %d epochs, baseline %.0f m, residual lag-1 corr. %.2f%s\n",
                   r.cal_fit.scale, r.cal_fit.scale_sigma, rad_to_deg(r.cal_fit.heading_bias_rad),
                   rad_to_deg(r.cal_fit.heading_bias_sigma_rad), r.cal_fit.epochs, r.cal_fit.baseline_m, r.cal_fit.residual_rho,
-                  course_note(r.cal_fit).c_str());
+                  calibration_note(r.cal_fit).c_str());
     std::fflush(stdout);
     results.push_back(r);
   }

@@ -42,6 +42,7 @@
 #include "pdnav/io/sample_source.h"
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/phonesim/handling.h"
+#include "support/replay_support.h"
 
 namespace pdnav::cli {
 namespace {
@@ -157,7 +158,7 @@ struct WalkResult {
   std::vector<double> still_errors_m;       // "still": the estimate stays at the start
   std::int64_t naive_steps = 0;
   std::string reference = "truth";        // what the walk was scored against (truth | fixes)
-  std::int64_t fixes_used = 0, fixes_rejected = 0;  // --reference fixes: scored / over the accuracy bound
+  std::int64_t fixes_used = 0, fixes_rejected = 0;  // --reference fixes: scored / not (accuracy, provider)
   std::int64_t steps_in_truth_span = -1, naive_steps_in_truth_span = -1;  // -1: no Meta TruthStepsFrom/ToNanos
   double truth_path_m = kNaN, final_m = kNaN, naive_final_m = kNaN, still_final_m = kNaN;
   double rms_pct = kNaN, naive_rms_pct = kNaN, still_rms_pct = kNaN;  // RMS error / truth path, % (aligned)
@@ -399,8 +400,9 @@ std::vector<Sample> with_waving(const std::vector<Sample>& in, const EvalPdrArgs
 }
 
 /// The phone's own fixes as the reference (a logger walk outdoors has no surveyed truth): each
-/// Fix row stating a 68 % accuracy <= --fix-max-accuracy-m becomes a Truth point, the others are
-/// counted and dropped; Truth lines already in the log are dropped (one reference per walk).
+/// GPS Fix row (is_gps_reference_fix, as replay and eval-outage) stating a 68 % accuracy <=
+/// --fix-max-accuracy-m becomes a Truth point, the others are counted and dropped; Truth lines
+/// already in the log are dropped (one reference per walk).
 std::vector<Sample> fixes_as_reference(const std::vector<Sample>& in, double max_accuracy_m, WalkResult& r) {
   std::vector<Sample> out;
   out.reserve(in.size());
@@ -411,8 +413,7 @@ std::vector<Sample> fixes_as_reference(const std::vector<Sample>& in, double max
       out.push_back(s);
       continue;
     }
-    if (!std::isfinite(f->lat_deg) || !std::isfinite(f->lon_deg) || !std::isfinite(f->accuracy_m) ||
-        f->accuracy_m > max_accuracy_m) {
+    if (!is_gps_reference_fix(*f) || !std::isfinite(f->accuracy_m) || f->accuracy_m > max_accuracy_m) {
       ++r.fixes_rejected;
       continue;
     }
@@ -436,11 +437,10 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   if (a.reference == "fixes" || (a.reference == "auto" && truth_lines < 2)) {
     samples = fixes_as_reference(samples, a.fix_max_accuracy_m, r);
     r.reference = "fixes";
-    if (r.fixes_used < 2)
-    {
+    if (r.fixes_used < 2) {
       std::ostringstream o;
       o << path << ": fewer than 2 Truth lines and fewer than 2 fixes stating accuracy <= " << a.fix_max_accuracy_m
-        << " m (" << r.fixes_used << " such fixes, " << r.fixes_rejected << " worse or without accuracy): nothing to score";
+        << " m (" << r.fixes_used << " such fixes, " << r.fixes_rejected << " other fixes: worse, without accuracy or not GPS): nothing to score";
       throw std::runtime_error(o.str());
     }
   }
@@ -679,7 +679,7 @@ int run_eval_pdr(const EvalPdrArgs& a) {
                 *std::max_element(r.errors_m.begin(), r.errors_m.end()), r.length_ratio,
                 median(r.seg_heading_err_deg), r.naive_mean_m, r.naive_ratio);
     if (r.reference == "fixes")
-      std::printf("    reference: the phone's fixes, %lld scored (accuracy <= %.1f m), %lld over the bound\n",
+      std::printf("    reference: the phone's GPS fixes, %lld scored (accuracy <= %.1f m), %lld others not\n",
                   static_cast<long long>(r.fixes_used), a.fix_max_accuracy_m, static_cast<long long>(r.fixes_rejected));
     if (a.wave_s > 0.0)
       std::printf("    waving_steps: %lld (naive %lld)\n", static_cast<long long>(r.waving_steps),

@@ -101,7 +101,7 @@ add_test(NAME pdr_cli_eval_pdr_no_fixes
          COMMAND sh -c "$0 eval-pdr --reference fixes \"$1\" 2>&1; echo rc=$?" $<TARGET_FILE:pdnav>
                  "${_pdr_tyrex_out}/logs/tyrex/Guillaume_Nexus5_NoDist_Texting.log")
 set_tests_properties(pdr_cli_eval_pdr_no_fixes PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
-                     PASS_REGULAR_EXPRESSION "Guillaume_Nexus5_NoDist_Texting\\.log: fewer than 2 Truth lines and fewer than 2 fixes stating accuracy <= 10 m \\(0 such fixes, 0 worse or without accuracy\\): nothing to score.*no walk could be evaluated.*rc=1")
+                     PASS_REGULAR_EXPRESSION "Guillaume_Nexus5_NoDist_Texting\\.log: fewer than 2 Truth lines and fewer than 2 fixes stating accuracy <= 10 m \\(0 such fixes, 0 other fixes: worse, without accuracy or not GPS\\): nothing to score.*no walk could be evaluated.*rc=1")
 # tools/tyrex2log on bad input: a recording whose accelerometer file has a short line and a
 # non-number (skipped, counted, file:line on stderr) converts; one without its motion-capture
 # file is an error with its path, and the run says 1 of 2 converted (exit 1).

@@ -60,14 +60,18 @@ nlohmann::json ErrorStats::to_json() const {
           {"p50_horizontal_m", p50_h_m}, {"p95_horizontal_m", p95_h_m}, {"coverage_1sigma", coverage_1sigma}, {"coverage_68", coverage_68}};
 }
 
+bool is_gps_reference_fix(const FixSample& f) {
+  std::string p = f.provider;
+  std::transform(p.begin(), p.end(), p.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  return p == "GPS" && std::isfinite(f.lat_deg) && std::isfinite(f.lon_deg);
+}
+
 void ReplayRecorder::observe_reference(const Sample& s) {
   if (const auto* t = std::get_if<TruthSample>(&s)) {
     if (std::isfinite(t->lat_deg) && std::isfinite(t->lon_deg))
       truth_.push_back({t->t_ns, geo::Geodetic::from_deg(t->lat_deg, t->lon_deg, std::isfinite(t->h_m) ? t->h_m : 0.0)});
   } else if (const auto* f = std::get_if<FixSample>(&s)) {
-    std::string p = f->provider;
-    std::transform(p.begin(), p.end(), p.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
-    if (p == "GPS" && std::isfinite(f->lat_deg) && std::isfinite(f->lon_deg))
+    if (is_gps_reference_fix(*f))
       fixes_.push_back({f->t_ns, geo::Geodetic::from_deg(f->lat_deg, f->lon_deg, std::isfinite(f->alt_m) ? f->alt_m : 0.0)});
   }
 }

@@ -47,6 +47,11 @@ struct ErrorStats {
   nlohmann::json to_json() const;
 };
 
+/// A Fix row that is a reference position (replay's error figures, eval-outage, eval-pdr
+/// --reference fixes): provider GPS (any case; network and fused fixes are not), finite
+/// latitude and longitude.
+bool is_gps_reference_fix(const FixSample& f);
+
 /// One output epoch of the replay.
 struct Epoch {
   Estimate est;

@@ -133,6 +133,20 @@ double account_for_drift(double a_rad, double a_var, double b_rad, double b_var,
   return drift;
 }
 
+/// Inverse-variance combination of a second estimate (y, sy) into (x, sx), or (y, sy) itself
+/// when there is no first one; angles (circular) combine along the shorter arc.
+void combine(bool have_first, double* x, double* sx, double y, double sy, bool circular) {
+  if (!have_first) {
+    *x = y;
+    *sx = sy;
+    return;
+  }
+  const double wx = 1.0 / (*sx * *sx), wy = 1.0 / (sy * sy);
+  *x = circular ? std::remainder(*x + std::remainder(y - *x, 2.0 * kPi) * wy / (wx + wy), 2.0 * kPi)
+                : (wx * *x + wy * y) / (wx + wy);
+  *sx = 1.0 / std::sqrt(wx + wy);
+}
+
 struct SeriesFit {
   bool ok = false;
   double mean = 0.0, var = 0.0;
@@ -283,14 +297,7 @@ void PdrCalibrator::fit() {
     if (k.ok && ks > 0.0) {
       c.course_bias_rad = kb;
       c.course_bias_sigma_rad = ks;
-      if (have_heading) {
-        const double wp = 1.0 / (c.heading_bias_sigma_rad * c.heading_bias_sigma_rad), wk = 1.0 / (ks * ks);
-        c.heading_bias_rad = std::remainder(c.heading_bias_rad + std::remainder(kb - c.heading_bias_rad, 2.0 * kPi) * wk / (wp + wk), 2.0 * kPi);
-        c.heading_bias_sigma_rad = 1.0 / std::sqrt(wp + wk);
-      } else {
-        c.heading_bias_rad = kb;
-        c.heading_bias_sigma_rad = ks;
-      }
+      combine(have_heading, &c.heading_bias_rad, &c.heading_bias_sigma_rad, kb, ks, true);
       have_heading = true;
     }
   }
@@ -302,28 +309,18 @@ void PdrCalibrator::fit() {
     if (v.ok && v.var > 0.0) {
       c.speed_scale = std::exp(v.mean);
       c.speed_scale_sigma = c.speed_scale * std::sqrt(v.var);
-      if (have_scale) {
-        const double wp = 1.0 / (c.scale_sigma * c.scale_sigma), wv = 1.0 / (c.speed_scale_sigma * c.speed_scale_sigma);
-        c.scale = (wp * c.scale + wv * c.speed_scale) / (wp + wv);
-        c.scale_sigma = 1.0 / std::sqrt(wp + wv);
-      } else {
-        c.scale = c.speed_scale;
-        c.scale_sigma = c.speed_scale_sigma;
-      }
+      combine(have_scale, &c.scale, &c.scale_sigma, c.speed_scale, c.speed_scale_sigma, false);
       have_scale = true;
     }
   }
-  if (!have_heading) {  // nothing measured it: the prior (not applied below)
-    c.heading_bias_rad = 0.0;
-    c.heading_bias_sigma_rad = std::max(c.heading_bias_sigma_rad, opt_.prior_heading_bias_sigma_rad);
-  }
   // Scale and heading bias are published independently: a heading fit that does not know the
   // bias to max_heading_bias_sigma_rad is not applied (bias 0, the filter keeps its prior
-  // uncertainty, prior_heading_bias_sigma_rad) while a good scale still is.
+  // uncertainty, prior_heading_bias_sigma_rad) while a good scale still is. With nothing that
+  // measured the heading, the same prior.
   c.heading_applied = have_heading && c.heading_bias_sigma_rad <= opt_.max_heading_bias_sigma_rad;
   c.valid = c.epochs >= opt_.min_epochs && have_scale && c.scale >= opt_.min_scale && c.scale <= opt_.max_scale &&
             c.scale_sigma <= opt_.max_scale_sigma && (opt_.independent_heading || c.heading_applied);
-  if (c.valid && !c.heading_applied) {
+  if (!have_heading || (c.valid && !c.heading_applied)) {
     c.heading_bias_rad = 0.0;
     c.heading_bias_sigma_rad = std::max(c.heading_bias_sigma_rad, opt_.prior_heading_bias_sigma_rad);
   }
