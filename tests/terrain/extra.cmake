@@ -63,3 +63,9 @@ add_test(NAME terrain.eval_tile_too_small
 set_tests_properties(terrain.eval_tile_too_small PROPERTIES FIXTURES_REQUIRED terrain_tile_tiny LABELS "terrain;cli"
   PASS_REGULAR_EXPRESSION "skipped: simulate: DEM tile too small for the edge margin.*only 0 of 2 walks fit the tile after 6 seeds"
   TIMEOUT 60)
+
+# The DR error breakdown whole-walks and the demo print (tools/track_breakdown.py): the oracle
+# rebuilds remove exactly the error source they know about on synthetic tracks.
+add_test(NAME terrain.track_breakdown
+  COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/terrain/check_track_breakdown.py")
+set_tests_properties(terrain.track_breakdown PROPERTIES LABELS "terrain;tools" TIMEOUT 60)
