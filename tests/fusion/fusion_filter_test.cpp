@@ -199,30 +199,48 @@ TEST(FusionFilter, HeadingBiasVarianceAfterAWindowFollowsTheGaussMarkovModel) {
   EXPECT_NEAR(unknown.heading_bias_expected(b, 300.0), b, 1e-12);
 }
 
-// Issue 28: the residual step-scale error is a Gauss-Markov process with the unknown walker's
-// sigma: a calibration's knowledge of the scale fades back to the prior (a walker's pace and
-// stride change over minutes), at the rate the window fit's own variance predicts.
-TEST(FusionFilter, ScaleErrorFadesBackToThePriorAsAGaussMarkovProcess) {
-  FusionFilter f;  // scale_tau_s 300 s, initial_scale_sigma 0.15
-  const double tau = f.options().scale_tau_s, s2 = std::pow(f.options().initial_scale_sigma, 2);
+// Issue 28: the residual step-scale error is a Gauss-Markov process. Before a calibration its
+// stationary sigma is the unknown walker's (initial_scale_sigma: the spread between walkers, a
+// constant the filter never forgets it does not know); once a calibration has learnt the walker,
+// what wanders is the scale within the walk (scale_within_walk_sigma), and the calibration's
+// knowledge fades to that, at the rate the window fit's own variance predicts.
+TEST(FusionFilter, ScaleErrorFadesBackToTheWithinWalkSigmaAsAGaussMarkovProcess) {
+  FusionFilter f;  // scale_tau_s 300 s, initial_scale_sigma 0.15, scale_within_walk_sigma 0.10
+  const double tau = f.options().scale_tau_s, prior2 = std::pow(f.options().initial_scale_sigma, 2),
+               walk2 = std::pow(f.options().scale_within_walk_sigma, 2);
   ASSERT_GT(tau, 0.0);
+  ASSERT_GT(walk2, 0.0);
+  ASSERT_LT(walk2, prior2);
   f.initialize(Eigen::Vector2d::Zero(), 3.0, 0);
   const double fit = 0.02 * 0.02;
   EXPECT_NEAR(f.scale_var_after_window(fit, 1e-6), fit, 1e-9);
-  EXPECT_NEAR(f.scale_var_after_window(fit, tau), fit + 0.4715 * s2, 1e-3 * s2);  // g(1) = 0.4715
+  EXPECT_NEAR(f.scale_var_after_window(fit, tau), fit + 0.4715 * walk2, 1e-3 * walk2);  // g(1) = 0.4715
   f.set_residual_uncertainty(1e-4, fit);
   const double rw = f.options().scale_rw_1ps;
   f.advance_to(static_cast<TimeNs>(tau * 1e9 / 2));  // in two steps: the same as one
   f.advance_to(static_cast<TimeNs>(tau * 1e9));      // one correlation time: phi = 1/e
   const double phi2 = std::exp(-2.0);
-  EXPECT_NEAR(f.scale_error_var(), phi2 * fit + (1.0 - phi2) * s2, 1e-9);
-  f.advance_to(static_cast<TimeNs>(20.0 * tau * 1e9));  // long after: the prior
-  EXPECT_NEAR(f.scale_error_var(), s2, 1e-9);
+  EXPECT_NEAR(f.scale_error_var(), phi2 * fit + (1.0 - phi2) * walk2, 1e-9);
+  f.advance_to(static_cast<TimeNs>(20.0 * tau * 1e9));  // long after: the within-walk variance
+  EXPECT_NEAR(f.scale_error_var(), walk2, 1e-9);
   // an uncalibrated filter stays at the prior: it never claims less than it started with
   FusionFilter g;
   g.initialize(Eigen::Vector2d::Zero(), 3.0, 0);
   g.advance_to(static_cast<TimeNs>(600e9));
-  EXPECT_NEAR(g.scale_error_var(), s2, 1e-12);
+  EXPECT_NEAR(g.scale_error_var(), prior2, 1e-12);
+  // ... and a new start forgets the calibration: the prior again
+  f.initialize(Eigen::Vector2d::Zero(), 3.0, static_cast<TimeNs>(21.0 * tau * 1e9));
+  f.advance_to(static_cast<TimeNs>(40.0 * tau * 1e9));
+  EXPECT_NEAR(f.scale_error_var(), prior2, 1e-12);
+  // scale_within_walk_sigma <= 0: the walker's prior throughout (the model before)
+  FusionFilterOptions one_level;
+  one_level.scale_within_walk_sigma = 0.0;
+  FusionFilter k(one_level);
+  k.initialize(Eigen::Vector2d::Zero(), 3.0, 0);
+  EXPECT_NEAR(k.scale_var_after_window(fit, tau), fit + 0.4715 * prior2, 1e-3 * prior2);
+  k.set_residual_uncertainty(1e-4, fit);
+  k.advance_to(static_cast<TimeNs>(20.0 * tau * 1e9));
+  EXPECT_NEAR(k.scale_error_var(), prior2, 1e-9);
   // scale_tau_s = 0: the random walk alone (before this model)
   FusionFilterOptions rw_only;
   rw_only.scale_tau_s = 0.0;

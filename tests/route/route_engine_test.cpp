@@ -125,6 +125,33 @@ TEST(RouteEngine, ReportedCovarianceGrowsAlongTheStreetNotAcrossIt) {
   EXPECT_GT(b.cov_en_m2(1, 1), 4.0 * a.cov_en_m2(1, 1));
 }
 
+// The caller's step-scale sigma (the Navigator: the fusion filter's residual scale sigma of the
+// calibrated steps it feeds) sets that along-track growth instead of the 5 % constant: the same
+// walk with 20 % reports (0.20^2 - 0.05^2) d^2 more along-track variance, the across-track unchanged.
+TEST(RouteEngine, CallersStepScaleSigmaSetsTheAlongTrackGrowth) {
+  auto g = crossing();
+  auto along_after_straight_walk = [&](double scale_sigma, double* across) {
+    RouteEngine e(RouteOptions{}, g, 1);
+    if (scale_sigma > 0.0) e.set_step_scale_sigma(scale_sigma);
+    e.feed(fix_at(*g, {0, -190}, 3.0, kNsPerS));
+    walk(e, kNsPerS, 180, 0.75, 0.0);  // 135 m north, no turn
+    const Estimate b = e.estimate();
+    EXPECT_TRUE(b.valid());
+    *across = std::sqrt(b.cov_en_m2(0, 0));
+    return std::sqrt(b.cov_en_m2(1, 1));
+  };
+  double across_default = 0.0, across_20 = 0.0;
+  const double along_default = along_after_straight_walk(0.0, &across_default);
+  const double along_20 = along_after_straight_walk(0.20, &across_20);
+  std::printf("along-track sigma after 135 m: %.1f m (5 %%), %.1f m (20 %%)\n", along_default, along_20);
+  EXPECT_GT(along_20, 0.20 * 135.0);
+  EXPECT_LT(along_20, 0.20 * 135.0 + 10.0);
+  // the routes' own spread is the same in both: the variances differ by (0.20^2 - 0.05^2) d^2
+  const double d = 135.0;
+  EXPECT_NEAR(along_20 * along_20 - along_default * along_default, (0.20 * 0.20 - 0.05 * 0.05) * d * d, 0.02 * 0.04 * d * d);
+  EXPECT_NEAR(across_20, across_default, 1e-9);
+}
+
 TEST(RouteEngine, UnmatchableTurnLosesAllRoutesAndNextFixRestarts) {
   auto g = crossing();
   RouteOptions apt;  // the paper's behaviour: no local restart

@@ -53,6 +53,7 @@ void FusionFilter::initialize(const Eigen::Vector2d& en_m, double sigma_m, TimeN
   recent_.clear();
   rejected_.clear();
   reacq_.clear();
+  scale_calibrated_ = false;
   initialized_ = true;
 }
 
@@ -74,7 +75,7 @@ void FusionFilter::advance_to(TimeNs t_ns) {
     gauss_markov_step(2, dt_all, opt_.heading_bias_tau_s, heading_stationary_var_);
   p_(2, 2) += opt_.heading_bias_rw_rad2ps * dt_all;
   if (opt_.scale_tau_s > 0.0)
-    gauss_markov_step(3, dt_all, opt_.scale_tau_s, opt_.initial_scale_sigma * opt_.initial_scale_sigma);
+    gauss_markov_step(3, dt_all, opt_.scale_tau_s, scale_stationary_var());
   else
     p_(3, 3) += opt_.scale_rw_1ps * dt_all;  // the random walk only without the Gauss-Markov model
   t_ns_ = t_ns;
@@ -121,6 +122,7 @@ void FusionFilter::predict(const PdrStep& s) {
 void FusionFilter::set_residual_uncertainty(double var_b, double var_s) {
   if (!initialized_) return;
   // fold the old residual estimate into nothing: the new calibration replaces it
+  scale_calibrated_ = true;
   x_(2) = 0.0;
   x_(3) = 0.0;
   for (int i = 0; i < 6; ++i) {
@@ -155,9 +157,17 @@ double FusionFilter::heading_bias_expected(double calibrated_rad, double age_s) 
   return calibrated_rad * std::exp(-age_s / opt_.heading_bias_tau_s);
 }
 
+double FusionFilter::scale_stationary_var() const {
+  const double s = scale_calibrated_ && opt_.scale_within_walk_sigma > 0.0 ? opt_.scale_within_walk_sigma
+                                                                          : opt_.initial_scale_sigma;
+  return s * s;
+}
+
 double FusionFilter::scale_var_after_window(double fit_var, double window_s) const {
   if (!(opt_.scale_tau_s > 0.0) || !(window_s > 0.0)) return fit_var;
-  return fit_var + gm_var_about_window_mean(opt_.initial_scale_sigma * opt_.initial_scale_sigma, window_s, opt_.scale_tau_s);
+  // the window's scale wanders within the walk (the fit has learnt the walker's constant)
+  const double s = opt_.scale_within_walk_sigma > 0.0 ? opt_.scale_within_walk_sigma : opt_.initial_scale_sigma;
+  return fit_var + gm_var_about_window_mean(s * s, window_s, opt_.scale_tau_s);
 }
 
 void FusionFilter::after(TimeNs t_ns, Eigen::Vector2d* d, double* var) const {

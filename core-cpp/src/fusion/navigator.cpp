@@ -66,6 +66,8 @@ FusionOptions fusion_options_before_issue28() {
   o.calibration.independent_heading = false;
   o.calibration.use_course = false;
   o.calibration.use_speed = false;
+  o.route_scale_from_filter = false;
+  o.filter.scale_within_walk_sigma = 0.0;
   return o;
 }
 
@@ -456,6 +458,7 @@ struct Navigator::Impl {
     const PdrStep c = calibrated(raw);
     ff.predict(c);
     if (terrain) terrain->feed(c);
+    if (route && fo().route_scale_from_filter) route->set_step_scale_sigma(std::sqrt(std::max(0.0, ff.scale_error_var())));
     if (route) route->feed(c);
     for (const PdrTurn& t : pdr.take_turns())
       if (route) route->feed(t);

@@ -422,10 +422,11 @@ void RouteEngine::update_clusters() {
     const Eigen::Vector2d d = p - seeds[c];  // relative to the seed for numerical stability
     a.w += w[i]; a.wx += w[i] * d; a.wxx += w[i] * d.x() * d.x(); a.wxy += w[i] * d.x() * d.y();
     a.wyy += w[i] * d.y() * d.y(); ++a.n;
-    // the route's own along-track variance (the one reseed_along_track weighs routes by): a step
-    // scale error moves every route of a cluster together, so their spread does not show it
+    // the route's own along-track variance: a step scale error moves every route of a cluster
+    // together, so their spread does not show it (with the caller's scale sigma when it gave one;
+    // reseed_along_track ranks with the constant)
     const Eigen::Vector2d& u = graph_->segment(routes_[i].seg).dir;
-    const double s_along = kStepScaleSigma * routes_[i].since_snap_m;
+    const double s_along = (step_scale_sigma_ > 0.0 ? step_scale_sigma_ : kStepScaleSigma) * routes_[i].since_snap_m;
     a.w_along += w[i] * s_along * s_along * u * u.transpose();
   }
   for (std::size_t c = 0; c < seeds.size(); ++c) {

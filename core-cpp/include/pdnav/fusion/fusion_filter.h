@@ -40,6 +40,14 @@ struct FusionFilterOptions {
   /// ETH walk: fitted scale 1.22 / 1.40 / 1.24 over consecutive 2-5 min spans, docs/fusion.md).
   /// 0 = the random walk alone (the model before this option).
   double scale_tau_s = 300.0;
+  /// ... and, once a calibration has been applied (set_residual_uncertainty), the stationary
+  /// sigma of that process is the step scale's variation WITHIN a walk, not the spread between
+  /// walkers (initial_scale_sigma, which the calibration has learnt): the walker's constant is
+  /// known to the calibration's own sigma, what remains is pace, ground and carry. Measured on
+  /// our PDR over the real sets: TYREX 20 s windows about each walk's median, sd of the log length
+  /// ratio 0.104 (robust 0.080, 12 walks); the ETH walk's fitted scale over consecutive 2-5 min
+  /// spans 1.22 / 1.40 / 1.24, sd of the log 0.075 (docs/fusion.md). <= 0: initial_scale_sigma.
+  double scale_within_walk_sigma = 0.10;
   /// The PDR's stated heading 1-sigma (PdrStep::heading_sigma_rad: compass / rotation vector
   /// accuracy) is the sigma of a slowly varying error (magnetic disturbances along the way, gyro
   /// drift), not of independent per-step noise: the heading bias state is a first-order
@@ -107,8 +115,8 @@ class FusionFilter {
   /// average out). The step scale is not treated so: a walker's stride differs from the model
   /// by a constant of its own. Without the model: calibrated_rad.
   double heading_bias_expected(double calibrated_rad, double age_s) const;
-  /// The same for the step scale (scale_tau_s, initial_scale_sigma): the variance of the scale
-  /// error now given a fit of its window average with variance fit_var.
+  /// The same for the step scale (scale_tau_s, scale_within_walk_sigma): the variance of the
+  /// scale error now given a fit of its window average with variance fit_var.
   double scale_var_after_window(double fit_var, double window_s) const;
   /// Position measurement at t_ns (possibly before the last step: the steps after it are
   /// taken off the prediction) through the windowed gate. `R` is its 2x2 covariance.
@@ -159,6 +167,9 @@ class FusionFilter {
   /// The heading bias follows the Gauss-Markov model: a correlation time and the PDR's stated
   /// sigma (the stationary one) known from a step.
   bool heading_bias_gauss_markov() const { return opt_.heading_bias_tau_s > 0.0 && heading_stationary_var_ > 0.0; }
+  /// Stationary variance of the residual scale state: between walkers before a calibration,
+  /// within the walk after one (scale_within_walk_sigma).
+  double scale_stationary_var() const;
 
   FusionFilterOptions opt_;
   double floor_fraction_ = -1.0;  // per-update override of opt_.position_floor_fraction (< 0: none)
@@ -167,6 +178,7 @@ class FusionFilter {
   Mat6 p_ = Mat6::Identity();
   TimeNs t_ns_ = 0;
   double heading_stationary_var_ = -1.0;  // the PDR's stated heading variance (last step), < 0 unknown
+  bool scale_calibrated_ = false;          // a calibration was applied: the scale wanders within the walk
   TimeNs last_step_ns_ = -1;
   TimeNs last_accept_ns_ = -1;
   bool clone_ok_ = false;

@@ -82,6 +82,11 @@ struct FusionOptions {
   double aid_var_scale = 1.0;         // ... their covariance times this
   double aid_min_sigma_m = 5.0;       // ... plus this 1-sigma (map/model error the engines do not state)
   bool aid_with_route = true;
+  /// The route engine's along-track covariance grows with the filter's residual scale sigma
+  /// (the steps it is fed are calibrated by the same calibration), not APT's fixed 5 %: on
+  /// eval-fusion walks whose calibration was learnt on a steeper grade the route claimed a few
+  /// metres while its along-track error reached 100 m (docs/fusion.md). false = 5 %.
+  bool route_scale_from_filter = true;
   bool aid_with_terrain = true;
   int wrong_lock_after = 3;           // engine rejected this many times in a row: re-anchored
   // blending of the shown position

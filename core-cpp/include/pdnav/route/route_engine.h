@@ -69,6 +69,11 @@ class RouteEngine {
   bool needs_fix() const;
   std::vector<Candidate> candidates(std::size_t max) const;
 
+  /// 1-sigma of the fed steps' length scale error (fraction), for the along-track part of the
+  /// covariance estimate() reports (sigma x the distance since the route's last snap). The
+  /// Navigator sets it before each step to the fusion filter's residual scale sigma (the steps
+  /// it feeds are calibrated); <= 0 (the default) = 5 %, the constant the ranking uses too.
+  void set_step_scale_sigma(double sigma) { step_scale_sigma_ = sigma; }
   std::size_t route_count() const { return routes_.size(); }
   std::size_t restarts() const { return restarts_; }            // from a GNSS fix
   std::size_t local_restarts() const { return local_restarts_; }  // around the last estimate
@@ -124,6 +129,7 @@ class RouteEngine {
   std::vector<Cluster> clusters_;
   std::deque<std::pair<TimeNs, double>> recent_steps_;  // (t, length) for turn snapping
   bool truncated_ = false;
+  double step_scale_sigma_ = 0.0;  // set_step_scale_sigma (<= 0: kStepScaleSigma)
   bool initialised_ = false;
   std::size_t restarts_ = 0;
   std::size_t local_restarts_ = 0;
