@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "../support/walk_fixtures.h"
 #include "pdnav/fusion/navigator.h"
 #include "pdnav/route/walk_graph.h"
 
@@ -18,7 +19,6 @@ namespace pdnav::fusion {
 namespace {
 
 constexpr TimeNs kStepNs = 550 * kNsPerMs;
-constexpr std::int64_t kUtc2026Ms = 1780272000000;  // 2026-06-01T00:00:00Z
 const geo::Geodetic kOrigin = geo::Geodetic::from_deg(42.5, 1.5, 0.0);
 
 /// One straight street 1 km north from the origin.
@@ -31,25 +31,12 @@ std::shared_ptr<const route::WalkGraph> street() {
   return std::make_shared<const route::WalkGraph>(route::WalkGraph::build(kOrigin, v, {e}));
 }
 
-/// Android step events, phone upright on the chest facing magnetic north (rotation vector).
+/// Android step events of a chest-mounted phone, the walker facing (magnetic) north.
 void walk_north(Navigator& nav, TimeNs& t, int steps) {
-  Eigen::Matrix3d rot;  // device X east, Y up, Z south: facing magnetic north
-  rot.col(0) = Eigen::Vector3d(1, 0, 0);
-  rot.col(1) = Eigen::Vector3d(0, 0, 1);
-  rot.col(2) = Eigen::Vector3d(0, -1, 0);
-  const Eigen::Quaterniond q(rot);
+  const Eigen::Quaterniond q = test::chest_facing(0.0);
   for (int k = 0; k < steps; ++k) {
     t += kStepNs;
-    RotationVectorSample rv;
-    rv.t_ns = t - kNsPerMs;
-    rv.utc_ms = kUtc2026Ms + t / kNsPerMs;
-    rv.quat_xyzw = Eigen::Vector4d(q.x(), q.y(), q.z(), q.w());
-    rv.heading_accuracy_rad = 0.1;
-    nav.feed(rv);
-    StepDetectorSample sd;
-    sd.t_ns = t;
-    sd.utc_ms = kUtc2026Ms + t / kNsPerMs;
-    nav.feed(sd);
+    for (const Sample& s : test::step_events(t - kNsPerMs, t, q)) nav.feed(s);
   }
 }
 
