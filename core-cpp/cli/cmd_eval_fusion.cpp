@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -301,10 +302,10 @@ int run_eval_fusion(const EvalFusionArgs& a) {
       std::printf("%-5d %-9llu %-14s %7s %7s %7s %7s %7s\n", w, static_cast<unsigned long long>(ws % 1000000000ULL),
                   names[s], f1(rows[s][0].drms_m).c_str(), f1(rows[s][1].drms_m).c_str(), f1(rows[s][2].drms_m).c_str(),
                   f1(rows[s][3].drms_m).c_str(), f1(rows[s][4].drms_m).c_str());
-    std::printf("      walk %d: %.0f m, outage %.0f s, %.1f sats; outage_ratio %s, coverage_68 in outage %s, max_jump_sigma %s, reacquire_s %s%s, "
+    std::printf("      walk %d (seed %llu): %.0f m, outage %.0f s, %.1f sats; outage_ratio %s, coverage_68 in outage %s, max_jump_sigma %s, reacquire_s %s%s, "
                 "open_sky_ratio %s; calibration over the outage (scale err %%, heading err deg): dr %s/%s fused %s/%s; "
                 "truth: stride %.3f x APT, heading bias at outage %.1f deg\n",
-                w, r.length_m, r.outage_s, r.stats.mean_sats_tracked, f3(r.outage_ratio).c_str(),
+                w, static_cast<unsigned long long>(ws), r.length_m, r.outage_s, r.stats.mean_sats_tracked, f3(r.outage_ratio).c_str(),
                 f3(r.out_scored > 0 ? static_cast<double>(r.out_covered_68) / r.out_scored : kNaNd).c_str(),
                 f3(r.max_jump_sigma).c_str(), f1(r.reacquire_s).c_str(), r.reacquire_censored ? " (never, censored)" : "",
                 f3(r.open_sky_ratio).c_str(), f1(100 * r.cal_dr.first).c_str(), f1(r.cal_dr.second).c_str(),
@@ -336,6 +337,22 @@ int run_eval_fusion(const EvalFusionArgs& a) {
               med(e_out[1]).c_str(), med(e_out[2]).c_str(), med(e_out[3]).c_str(), med(e_out[4]).c_str());
   std::printf("median DRMS after outages (m):  fused %s dr %s gnss %s terrain %s route %s\n", med(e_after[0]).c_str(),
               med(e_after[1]).c_str(), med(e_after[2]).c_str(), med(e_after[3]).c_str(), med(e_after[4]).c_str());
+  // the walks far from their peers, with the whole seed (the table's column is cut to 9 digits)
+  // and the command that writes that session, to look at one
+  std::vector<std::size_t> order(results.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  auto key = [&](std::size_t k) { return std::isfinite(results[k].outage_ratio) ? results[k].outage_ratio : -1.0; };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return key(x) > key(y); });
+  std::printf("worst walks by outage_ratio:");
+  for (std::size_t i = 0; i < std::min<std::size_t>(3, order.size()); ++i) {
+    const WalkResult& r = results[order[i]];
+    std::printf("%s walk %zu (seed %llu) %s", i ? "," : "", order[i] + 1, static_cast<unsigned long long>(r.seed),
+                f3(r.outage_ratio).c_str());
+  }
+  std::printf("\nto write one: pdnav simulate --session --seed SEED --dem %s --graph %s --nav", a.dem.c_str(), a.graph.c_str());
+  for (const auto& n : a.nav) std::printf(" %s", n.c_str());
+  std::printf(" --outage-min %g --outage-max %g --lead %g --tail %g -o walk.log\n", a.outage_min_min, a.outage_max_min,
+              a.lead_s, a.tail_s);
   const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("walks: %zu run_time_s: %.1f fused coverage_68 in outages (pooled): %s\n", results.size(), run_s,
               f3(scored > 0 ? static_cast<double>(covered) / scored : kNaNd).c_str());

@@ -1,15 +1,20 @@
 #!/usr/bin/python3
 """Runs `pdnav eval-fusion ...` (the arguments after --) and checks that it ends with the
 bar line `outage_ratio: X max_jump_sigma: Y reacquire_s: Z open_sky_ratio: W`, that every
-walk printed its scenario rows, and that the figures are sane (finite, in physical ranges).
+walk printed its scenario rows, and that the figures are sane (finite, in physical ranges);
+then that the worst walk it names can be written again: its whole seed in the printed
+`pdnav simulate --session` command gives a session of the same length and outage.
 It does not check the issue's bar itself.
 
   check_eval_fusion.py -- PDNAV eval-fusion ARGS...
 """
 import math
+import os
 import re
+import shlex
 import subprocess
 import sys
+import tempfile
 
 
 def main(argv):
@@ -42,9 +47,33 @@ def main(argv):
     dr = re.search(r"median DRMS during outages \(m\): fused (\S+) dr (\S+) gnss (\S+)", r.stdout)
     if not dr or not (0.5 < float(dr.group(2)) < 2000.0):
         failures.append("dead reckoning DRMS during the outages missing or not in (0.5, 2000) m")
+    failures += check_worst_walk_reproduces(cmd[0], r.stdout)
     if failures:
         sys.exit("FAIL: " + "; ".join(failures))
     print("ok")
+
+
+def check_worst_walk_reproduces(pdnav, out):
+    walks = {int(m.group(1)): (m.group(2), float(m.group(3)), float(m.group(4)))
+             for m in re.finditer(r"^\s+walk (\d+) \(seed (\d+)\): (\d+) m, outage (\d+) s", out, re.M)}
+    worst = re.search(r"^worst walks by outage_ratio: walk (\d+) \(seed (\d+)\)", out, re.M)
+    how = re.search(r"^to write one: pdnav (simulate --session --seed SEED .*)$", out, re.M)
+    if not walks or not worst or not how:
+        return ["no per-walk seeds, worst-walk line or simulate command in the output"]
+    k, seed = int(worst.group(1)), worst.group(2)
+    if k not in walks or walks[k][0] != seed:
+        return [f"the worst walk {k} (seed {seed}) is not a walk of the table"]
+    with tempfile.TemporaryDirectory() as tmp:
+        args = shlex.split(how.group(1).replace("SEED", seed).replace("-o walk.log", ""))
+        sim = subprocess.run([pdnav] + args + ["-o", os.path.join(tmp, "walk.log")], capture_output=True, text=True)
+    m = re.search(r"simulated session: (\d+) m, .*?outage (\d+)-(\d+) s", sim.stdout)
+    if sim.returncode != 0 or not m:
+        return [f"the printed simulate command failed: {sim.stderr.strip()[-200:]}"]
+    length, outage = float(m.group(1)), float(m.group(3)) - float(m.group(2))
+    if abs(length - walks[k][1]) > 1.0 or abs(outage - walks[k][2]) > 1.5:
+        return [f"seed {seed} wrote {length:.0f} m / outage {outage:.0f} s, the table says {walks[k][1]:.0f} m / {walks[k][2]:.0f} s"]
+    print(f"worst walk {k} written again from seed {seed}: {length:.0f} m, outage {outage:.0f} s")
+    return []
 
 
 if __name__ == "__main__":
