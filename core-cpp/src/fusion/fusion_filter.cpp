@@ -157,17 +157,19 @@ double FusionFilter::heading_bias_expected(double calibrated_rad, double age_s) 
   return calibrated_rad * std::exp(-age_s / opt_.heading_bias_tau_s);
 }
 
-double FusionFilter::scale_stationary_var() const {
-  const double s = scale_calibrated_ && opt_.scale_within_walk_sigma > 0.0 ? opt_.scale_within_walk_sigma
-                                                                          : opt_.initial_scale_sigma;
+double FusionFilter::scale_within_walk_var() const {
+  const double s = opt_.scale_within_walk_sigma > 0.0 ? opt_.scale_within_walk_sigma : opt_.initial_scale_sigma;
   return s * s;
+}
+
+double FusionFilter::scale_stationary_var() const {
+  return scale_calibrated_ ? scale_within_walk_var() : opt_.initial_scale_sigma * opt_.initial_scale_sigma;
 }
 
 double FusionFilter::scale_var_after_window(double fit_var, double window_s) const {
   if (!(opt_.scale_tau_s > 0.0) || !(window_s > 0.0)) return fit_var;
   // the window's scale wanders within the walk (the fit has learnt the walker's constant)
-  const double s = opt_.scale_within_walk_sigma > 0.0 ? opt_.scale_within_walk_sigma : opt_.initial_scale_sigma;
-  return fit_var + gm_var_about_window_mean(s * s, window_s, opt_.scale_tau_s);
+  return fit_var + gm_var_about_window_mean(scale_within_walk_var(), window_s, opt_.scale_tau_s);
 }
 
 void FusionFilter::after(TimeNs t_ns, Eigen::Vector2d* d, double* var) const {

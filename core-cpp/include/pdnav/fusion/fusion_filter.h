@@ -167,8 +167,10 @@ class FusionFilter {
   /// The heading bias follows the Gauss-Markov model: a correlation time and the PDR's stated
   /// sigma (the stationary one) known from a step.
   bool heading_bias_gauss_markov() const { return opt_.heading_bias_tau_s > 0.0 && heading_stationary_var_ > 0.0; }
+  /// Variance of the scale's wander within a walk (scale_within_walk_sigma, else the walker's).
+  double scale_within_walk_var() const;
   /// Stationary variance of the residual scale state: between walkers before a calibration,
-  /// within the walk after one (scale_within_walk_sigma).
+  /// within the walk after one.
   double scale_stationary_var() const;
 
   FusionFilterOptions opt_;
