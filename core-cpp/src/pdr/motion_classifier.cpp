@@ -81,12 +81,16 @@ void MotionClassifier::update(TimeNs t_ns) {
     sigma = std::sqrt(std::max(0.0, acc_sq_ / n - mu * mu));
   }
   // running: turns like handling, but with periodic foot strikes and a rotation that keeps
-  // their rhythm (MotionClassifierOptions::running_min_coherence): gait, not handling
-  const bool running = opt_.vehicle && opt_.running_min_coherence > 0.0 && gait_corr_ >= opt_.gait_exit_min &&
-                       sigma >= opt_.running_min_sigma_mps2 && gait_coherence_ >= opt_.running_min_coherence;
+  // their rhythm (MotionClassifierOptions::running_min_coherence): gait, not handling. The
+  // strikes' periodicity enters a run; the rhythm keeps it, and the hold_s after it as for handling.
+  const bool keeps_rhythm = opt_.vehicle && opt_.running_min_coherence > 0.0 &&
+                            sigma >= opt_.running_min_sigma_mps2 && gait_coherence_ >= opt_.running_min_coherence;
+  running_state_ = keeps_rhythm && (running_state_ || gait_corr_ >= opt_.gait_exit_min);
+  const bool running = running_state_;
   if (running && turns_like_handling(1.0)) running_last_ns_ = t_ns;
-  handling_raw_ = !running && turns_like_handling(1.0);
-  suspect_ = !running && turns_like_handling(opt_.suspect_fraction);
+  const bool ran_recently = running_last_ns_ >= 0 && ns_to_s(t_ns - running_last_ns_) <= opt_.hold_s;
+  handling_raw_ = !running && !ran_recently && turns_like_handling(1.0);
+  suspect_ = !running && !ran_recently && turns_like_handling(opt_.suspect_fraction);
   // a session's first second (or after a gyro gap): no full window of evidence either way
   young_ = !gyro_.empty() && ns_to_s(gyro_.back().first - gyro_.front().first) < 0.8 * opt_.window_s;
   if (handling_raw_) handling_last_ns_ = t_ns;
