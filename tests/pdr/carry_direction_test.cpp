@@ -12,6 +12,7 @@
 // constant direction per bout is a fair model even for pockets and a swinging hand.
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -59,6 +60,16 @@ Recording read_tyrex(const std::string& name) {
   return r;
 }
 
+/// Feeds the recording's accelerometer (and gyroscope) samples in time order up to until_ns.
+void feed(Pdr& pdr, const Recording& r, bool with_gyro, TimeNs until_ns = std::numeric_limits<TimeNs>::max()) {
+  std::size_t g = 0;
+  for (const auto& a : r.accel) {
+    if (a.t_ns > until_ns) break;
+    while (with_gyro && g < r.gyro.size() && r.gyro[g].t_ns <= a.t_ns) pdr.feed(r.gyro[g++]);
+    pdr.feed(a);
+  }
+}
+
 /// Walking direction (phone axes) of the longest placement bout after feeding the recording up
 /// to until_s (the walker lowers the phone at the very end of some recordings).
 PlacementBout longest_bout(const Recording& r, bool with_gyro, double until_s = 110.0,
@@ -67,13 +78,7 @@ PlacementBout longest_bout(const Recording& r, bool with_gyro, double until_s = 
   o.heading.mount = Mount::kAuto;
   o.placement.rotation_axis_max_ratio = rotation_axis_max_ratio;
   Pdr pdr(o);
-  std::size_t g = 0;
-  const TimeNs until_ns = s_to_ns(until_s);
-  for (const auto& a : r.accel) {
-    if (a.t_ns > until_ns) break;
-    while (with_gyro && g < r.gyro.size() && r.gyro[g].t_ns <= a.t_ns) pdr.feed(r.gyro[g++]);
-    pdr.feed(a);
-  }
+  feed(pdr, r, with_gyro, s_to_ns(until_s));
   PlacementBout best;
   for (const PlacementBout& b : pdr.placements())
     if (b.t_end_ns - b.t_start_ns > best.t_end_ns - best.t_start_ns) best = b;
@@ -180,11 +185,7 @@ TEST(PdrMotion, ARunThatTurnsIsNotHandling) {
     PdrOptions o;
     o.heading.mount = Mount::kAuto;
     Pdr pdr(o);
-    std::size_t g = 0;
-    for (const auto& a : r.accel) {
-      while (g < r.gyro.size() && r.gyro[g].t_ns <= a.t_ns) pdr.feed(r.gyro[g++]);
-      pdr.feed(a);
-    }
+    feed(pdr, r, true);
     pdr.finish();
     const PdrCounters c = pdr.counters();
     std::printf("%-38s steps %lld, refused as handling %lld\n", name, static_cast<long long>(pdr.step_count()),
