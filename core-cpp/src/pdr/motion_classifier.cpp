@@ -86,11 +86,10 @@ void MotionClassifier::update(TimeNs t_ns) {
   const bool keeps_rhythm = opt_.vehicle && opt_.running_min_coherence > 0.0 &&
                             sigma >= opt_.running_min_sigma_mps2 && gait_coherence_ >= opt_.running_min_coherence;
   running_state_ = keeps_rhythm && (running_state_ || gait_corr_ >= opt_.gait_exit_min);
-  const bool running = running_state_;
-  if (running && turns_like_handling(1.0)) running_last_ns_ = t_ns;
-  const bool ran_recently = running_last_ns_ >= 0 && ns_to_s(t_ns - running_last_ns_) <= opt_.hold_s;
-  handling_raw_ = !running && !ran_recently && turns_like_handling(1.0);
-  suspect_ = !running && !ran_recently && turns_like_handling(opt_.suspect_fraction);
+  if (running_state_ && turns_like_handling(1.0)) running_last_ns_ = t_ns;
+  const bool gait = running_state_ || ran_within_hold(t_ns);
+  handling_raw_ = !gait && turns_like_handling(1.0);
+  suspect_ = !gait && turns_like_handling(opt_.suspect_fraction);
   // a session's first second (or after a gyro gap): no full window of evidence either way
   young_ = !gyro_.empty() && ns_to_s(gyro_.back().first - gyro_.front().first) < 0.8 * opt_.window_s;
   if (handling_raw_) handling_last_ns_ = t_ns;

@@ -128,7 +128,7 @@ class MotionClassifier {
   double vehicle_score_s() const { return vehicle_score_s_; }
   /// Vigorous gait (running, a swinging arm): the phone turns like handling, but the gait
   /// coherence test passes (true for hold_s after).
-  bool running() const { return running_last_ns_ >= 0 && last_acc_ns_ - running_last_ns_ <= s_to_ns(opt_.hold_s); }
+  bool running() const { return ran_within_hold(last_acc_ns_); }
   /// Rotation repeating with the gait (running_min_coherence): leaky mean, -1..1.
   double gait_coherence() const { return gait_coherence_; }
   /// True when t_ns lies inside a handling span (closed, or the open one).
@@ -178,9 +178,13 @@ class MotionClassifier {
   double vehicle_score_s_ = 0.0;
   TimeNs evidence_start_ns_ = -1;
   double gait_corr_ = 0.0;
-  double gait_coherence_ = 0.0;
-  bool running_state_ = false;
-  TimeNs running_last_ns_ = -1;  // leaky mean of the rotation's autocorrelation at the gait lag
+  double gait_coherence_ = 0.0;  // leaky mean of the rotation's autocorrelation at the gait lag
+  bool running_state_ = false;   // in a run: entered on periodic strikes, kept while the rhythm lasts
+  TimeNs running_last_ns_ = -1;  // last time running while turning like handling
+  /// Running while turning like handling within hold_s before t_ns.
+  bool ran_within_hold(TimeNs t_ns) const {
+    return running_last_ns_ >= 0 && t_ns - running_last_ns_ <= s_to_ns(opt_.hold_s);
+  }
   std::deque<MotionSpan> vehicle_spans_;
 };
 
