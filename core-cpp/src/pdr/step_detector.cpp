@@ -184,7 +184,8 @@ bool StepDetector::stride_like(TimeNs t_ns, double interval_s) const {
 
 void StepDetector::split_strides(const StepCandidate& c, std::vector<StepCandidate>& out) {
   const bool like = stride_like(c.t_ns, c.interval_s);
-  const bool split = like && prev_stride_like_;
+  // Walking: two in a row (one odd long interval may be a pause). Running: one is enough.
+  const bool split = like && (prev_stride_like_ || (running_ && opt_.running_single_stride));
   prev_stride_like_ = like;
   if (!split) {
     out.push_back(c);
