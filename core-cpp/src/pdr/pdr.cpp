@@ -360,6 +360,7 @@ void Pdr::feed(const GyroSample& s) {
   magcal_.add_gyro(s.t_ns, s.rate_radps);  // the attitude of the gyro-aided hard-iron fit
   placement_.feed(s);  // the tilt filter levels the walking-direction correlation
   classifier_.feed(s);
+  detector_.feed(s);   // the stride test reads the swing from the angular rate
   track_handling();
   if (s.rate_radps.allFinite() && s.t_ns >= last_gyro_ns_) last_gyro_ns_ = s.t_ns;
   latest_ns_ = std::max(latest_ns_, s.t_ns);
@@ -550,6 +551,7 @@ PdrCounters Pdr::counters() const {
   c.accel = detector_.counters();
   c.gyro = tracker_.gyro_counters();
   c.steps_discarded_by_bout_gate = gate_.discarded();
+  c.steps_added_at_stride_midpoints = detector_.stride_steps_added();
   c.mag_readings_trusted = fusion_.accepted();
   c.mag_readings_disturbed = fusion_.disturbed();
   return c;

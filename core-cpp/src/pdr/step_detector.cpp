@@ -177,9 +177,47 @@ bool StepDetector::stride_like(TimeNs t_ns, double interval_s) const {
   }
   const double a1 = std::abs(x1);
   const double step_power = a1 > 0.0 ? std::abs(x2) / a1 : 0.0;
+  if (step_power <= opt_.stride_harmonic_ratio) return false;
+  if (const std::optional<bool> rotates = rotates_at(t_ns, interval_s)) return *rotates;
   const double tilt_1 = 2.0 * d1.norm() / n;  // amplitude (rad, small-angle) at 1/I
   const double tilt_half = 2.0 * dh.norm() / n;
-  return step_power > opt_.stride_harmonic_ratio && tilt_1 > opt_.stride_min_tilt_rad && tilt_1 > tilt_half;
+  return tilt_1 > opt_.stride_min_tilt_rad && tilt_1 > tilt_half;
+}
+
+std::optional<bool> StepDetector::rotates_at(TimeNs t_ns, double interval_s) const {
+  const TimeNs from = t_ns - s_to_ns(2.0 * interval_s);
+  const TimeNs slack = s_to_ns(0.25 * interval_s);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  TimeNs first = 0, last = 0;
+  int n = 0;
+  for (const auto& r : rates_) {
+    if (r.t_ns < from || r.t_ns > t_ns) continue;
+    if (n == 0) first = r.t_ns;
+    last = r.t_ns;
+    mean += r.rate_radps;
+    ++n;
+  }
+  if (n < 8 || first - from > slack || t_ns - last > slack) return std::nullopt;
+  mean /= n;
+  // Single-bin DFTs of the angular rate (3 axes) at 1/I and 1/(2I), as for |a| above.
+  Eigen::Vector3cd r1 = Eigen::Vector3cd::Zero(), rh = Eigen::Vector3cd::Zero();
+  for (const auto& r : rates_) {
+    if (r.t_ns < from || r.t_ns > t_ns) continue;
+    const double ph = 2.0 * kPi * ns_to_s(r.t_ns - t_ns) / interval_s;
+    const Eigen::Vector3d w = r.rate_radps - mean;
+    r1 += w.cast<std::complex<double>>() * std::polar(1.0, -ph);
+    rh += w.cast<std::complex<double>>() * std::polar(1.0, -0.5 * ph);
+  }
+  const double rot_1 = 2.0 * r1.norm() / n, rot_half = 2.0 * rh.norm() / n;  // amplitudes, rad/s
+  return rot_1 > opt_.stride_min_rotation_radps && rot_1 > rot_half;
+}
+
+void StepDetector::feed(const GyroSample& s) {
+  if (opt_.stride_harmonic_ratio <= 0.0 || opt_.stride_min_rotation_radps <= 0.0 || !s.rate_radps.allFinite()) return;
+  if (!rates_.empty() && s.t_ns <= rates_.back().t_ns) return;  // duplicates and backwards: the Pdr counts them
+  rates_.push_back({s.t_ns, s.rate_radps});
+  const TimeNs keep = s_to_ns(2.0 * opt_.stride_max_interval_s);
+  while (!rates_.empty() && rates_.front().t_ns < s.t_ns - keep) rates_.pop_front();
 }
 
 void StepDetector::split_strides(const StepCandidate& c, std::vector<StepCandidate>& out) {

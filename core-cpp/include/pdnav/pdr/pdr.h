@@ -90,6 +90,7 @@ struct PdrCounters {
   std::int64_t steps_discarded_by_bout_gate = 0;
   std::int64_t steps_discarded_by_motion = 0;  // candidates while the phone was handled/waved
   std::int64_t steps_discarded_by_vehicle = 0;  // steps inside a vehicle span (car, bus, train)
+  std::int64_t steps_added_at_stride_midpoints = 0;  // swinging hand / running strides split (stage 4)
   std::int64_t mag_readings_trusted = 0;       // absolute headings that passed the WMM tests
   std::int64_t mag_readings_disturbed = 0;     // ... and that failed them (down-weighted)
   std::int64_t mag_readings_qsf_tested = 0;    // magnetometer readings tested for a quasi-static field

@@ -91,6 +91,13 @@ struct StepDetectorOptions {
   // oscillates once per interval by more than this amplitude, and more than at 1/(2I) (a
   // pocket phone on a slow walk swings with the thigh once per STRIDE = every 2 intervals).
   double stride_min_tilt_rad = 3.0 * kDegToRad;
+  // With a live gyroscope (Pdr feeds it) the swing is read from the angular rate instead: the
+  // rotation at 1/I must exceed this amplitude and the rotation at 1/(2I). A phone swinging
+  // with the arm is a pendulum, whose specific force stays along the arm: its tilt as seen by
+  // the accelerometer moves only 3-7 deg while the phone turns +-15-25 deg. Measured at the
+  // stride-like candidates (amplitude at 1/I, p10-p90): swinging hand 1.3-2.3 rad/s, runs
+  // 1.7-5.2; pockets, phone at the ear and hand-held (ILC) 0.5-1.0 rad/s. 0 = the tilt always.
+  double stride_min_rotation_radps = 1.0;
   // --- Input hygiene.
   double gap_reset_s = 0.5;            // a sample gap longer than this resets the detector
 
@@ -207,6 +214,9 @@ class StepDetector {
   /// order: none, one, or two when a stride was recognised (the midpoint step, then this one).
   /// Candidates are not yet bout-gated: use BoutGate (as Pdr and detect_steps do).
   std::vector<StepCandidate> feed(const AccelSample& s);
+  /// Feeds one calibrated gyroscope sample (optional): while its samples cover the interval,
+  /// the stride test reads the phone's swing from the angular rate (stride_min_rotation_radps).
+  void feed(const GyroSample& s);
   /// The walker is running (Pdr: MotionClassifier::running()): strides down to
   /// running_stride_min_interval_s are recognised.
   void set_running(bool running) { running_ = running; }
@@ -235,6 +245,9 @@ class StepDetector {
   std::optional<StepCandidate> on_symbol(Symbol sym, TimeNs t_ns, double value);
   void split_strides(const StepCandidate& c, std::vector<StepCandidate>& out);
   bool stride_like(TimeNs t_ns, double interval_s) const;
+  /// Whether the gyroscope shows the phone swinging at 1/I; nullopt when its samples do not
+  /// cover the last two intervals (no gyroscope, a gap, or a batch not yet delivered).
+  std::optional<bool> rotates_at(TimeNs t_ns, double interval_s) const;
 
   StepDetectorOptions opt_;
   SampleCounters counters_;
@@ -256,6 +269,11 @@ class StepDetector {
   // stride recognition (swinging hand)
   std::deque<Tilted> history_;       // the last 2 * stride_max_interval_s
   Eigen::Vector3d lpv1_ = Eigen::Vector3d::Zero(), lpv2_ = Eigen::Vector3d::Zero();
+  struct Rate {
+    TimeNs t_ns;
+    Eigen::Vector3d rate_radps;
+  };
+  std::deque<Rate> rates_;           // gyroscope, the last 2 * stride_max_interval_s
   bool prev_stride_like_ = false;
   bool running_ = false;
   std::int64_t stride_steps_added_ = 0;
