@@ -44,6 +44,7 @@ struct SwingSpec {
   double cadence_jitter = 0.03;     // random-walk spread of the cadence (fraction)
   double amplitude_jitter = 0.10;   // stride-to-stride spread of the swing drive (fraction)
   double accel_noise_mps2 = 0.04;
+  double gyro_noise_radps = 0.005;
   double accel_bias_mps2 = 0.08;
   double still_before_s = 3.0;      // standing (arm at rest) before and after the walk
   double still_after_s = 3.0;
@@ -53,6 +54,7 @@ struct SwingSpec {
 
 struct SwingWalk {
   std::vector<AccelSample> accel;
+  std::vector<GyroSample> gyro;  // the phone's angular rate, phone axes, at the accelerometer's times
   std::vector<TimeNs> heel_strikes_ns;  // truth
 };
 
@@ -153,6 +155,10 @@ inline SwingWalk make_swinging_walk(const SwingSpec& spec) {
   for (double s : strikes) out.heel_strikes_ns.push_back(1'000'000'000 + static_cast<TimeNs>(std::llround(s * 1e9)));
   double next_sample = 0.0;
   const double sample_dt = 1.0 / spec.rate_hz;
+  Eigen::Matrix3d prev_rot = Eigen::Matrix3d::Identity();
+  double prev_rot_t = 0.0;
+  bool have_prev_rot = false;
+  std::mt19937_64 gyro_rng(spec.seed ^ 0x9E3779B97F4A7C15ULL);  // its own stream: the accelerometer's noise is as before
   constexpr double kQuantum = 19.6133 * 2.0 / 65536.0;  // +-2 g in 16 bits
   for (double tt = 0.0; tt < duration; tt += kSimDt) {
     // RK4 on (theta, omega)
@@ -186,7 +192,20 @@ inline SwingWalk make_swinging_walk(const SwingSpec& spec) {
         f[k] = kQuantum * std::round(f[k] / kQuantum);
       }
       const TimeNs t_ns = 1'000'000'000 + static_cast<TimeNs>(std::llround((tt + jitter(rng)) * 1e9));
-      if (out.accel.empty() || t_ns > out.accel.back().t_ns) out.accel.push_back(AccelSample{t_ns, kMissingInt, f});
+      // Angular rate in phone axes from the attitude change since the last sample.
+      Eigen::Vector3d w = Eigen::Vector3d::Zero();
+      if (have_prev_rot) {
+        const Eigen::AngleAxisd d(prev_rot.transpose() * rot);
+        w = d.axis() * d.angle() / (tt - prev_rot_t);
+      }
+      for (int k = 0; k < 3; ++k) w[k] += spec.gyro_noise_radps * n01(gyro_rng);
+      prev_rot = rot;
+      prev_rot_t = tt;
+      have_prev_rot = true;
+      if (out.accel.empty() || t_ns > out.accel.back().t_ns) {
+        out.accel.push_back(AccelSample{t_ns, kMissingInt, f});
+        out.gyro.push_back(GyroSample{t_ns, kMissingInt, w});
+      }
       next_sample += sample_dt;
     }
     theta += kSimDt / 6.0 * (k1t + 2.0 * k2t + 2.0 * k3t + k4t);

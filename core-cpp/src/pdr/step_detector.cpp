@@ -188,16 +188,18 @@ std::optional<bool> StepDetector::rotates_at(TimeNs t_ns, double interval_s) con
   const TimeNs from = t_ns - s_to_ns(2.0 * interval_s);
   const TimeNs slack = s_to_ns(0.25 * interval_s);
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  TimeNs first = 0, last = 0;
+  TimeNs first = 0, last = 0, widest_gap = 0;
   int n = 0;
   for (const auto& r : rates_) {
     if (r.t_ns < from || r.t_ns > t_ns) continue;
     if (n == 0) first = r.t_ns;
+    else widest_gap = std::max(widest_gap, r.t_ns - last);
     last = r.t_ns;
     mean += r.rate_radps;
     ++n;
   }
-  if (n < 8 || first - from > slack || t_ns - last > slack) return std::nullopt;
+  // The samples must cover the two intervals (no batch still to come, no hole in the stream).
+  if (n < 8 || first - from > slack || t_ns - last > slack || widest_gap > slack) return std::nullopt;
   mean /= n;
   // Single-bin DFTs of the angular rate (3 axes) at 1/I and 1/(2I), as for |a| above.
   Eigen::Vector3cd r1 = Eigen::Vector3cd::Zero(), rh = Eigen::Vector3cd::Zero();
