@@ -70,6 +70,23 @@ void feed(Pdr& pdr, const Recording& r, bool with_gyro, TimeNs until_ns = std::n
   }
 }
 
+/// A TYREX recording with the step count of its motion capture and the span that count covers
+/// (tools/tyrex2log's Meta TruthSteps / TruthStepsFrom,ToNanos; the recordings' time + 1 s, as
+/// read_txyz reads them).
+struct CapturedWalk {
+  const char* name;
+  double from_s, to_s;
+  int capture_steps;
+};
+
+/// The steps the Pdr has emitted inside the span the capture counts.
+int steps_in_span(Pdr& pdr, const CapturedWalk& w) {
+  int n = 0;
+  for (const PdrStep& st : pdr.take_steps())
+    if (st.t_ns >= s_to_ns(w.from_s) && st.t_ns <= s_to_ns(w.to_s)) ++n;
+  return n;
+}
+
 /// Walking direction (phone axes) of the longest placement bout after feeding the recording up
 /// to until_s (the walker lowers the phone at the very end of some recordings).
 PlacementBout longest_bout(const Recording& r, bool with_gyro, double until_s = 110.0,
@@ -177,19 +194,13 @@ TEST(PdrMotion, ARunThatTurnsIsNotHandling) {
   // (MotionClassifier: hysteresis on the strikes' periodicity, the hold after it as for
   // handling). Measured, accelerometer + gyroscope as here: refused as handling 17 + 22 steps
   // before (the run dropped to handling whenever the strikes' periodicity dipped), 6 + 14 now.
-  // Steps against the capture's count over the span it counts (tools/tyrex2log: 313 steps in
-  // 6.67-121.17 s, 311 in 6.29-120.79 s, the recordings' time + 1 s as read here): before a
-  // single stride-like interval of a run was split (StepDetectorOptions::running_single_stride)
-  // 268 / 266 (-14.4 / -14.5 %), now within 10 %.
-  struct Run {
-    const char* name;
-    double from_s, to_s;
-    int capture_steps;
-  };
-  const Run runs[] = {{"Guillaume_Nexus5_NoDist_RunningHand", 6.67, 121.17, 313},
-                      {"Guillaume_Nexus5_NoDist_RunningPocket", 6.29, 120.79, 311}};
+  // Steps against the capture's count over the span it counts: before a single stride-like
+  // interval of a run was split (StepDetectorOptions::running_single_stride) 268 / 266
+  // (-14.4 / -14.5 %), now within 10 %.
+  const CapturedWalk runs[] = {{"Guillaume_Nexus5_NoDist_RunningHand", 6.67, 121.17, 313},
+                               {"Guillaume_Nexus5_NoDist_RunningPocket", 6.29, 120.79, 311}};
   std::int64_t refused = 0;
-  for (const Run& run : runs) {
+  for (const CapturedWalk& run : runs) {
     SCOPED_TRACE(run.name);
     const Recording r = read_tyrex(run.name);
     PdrOptions o;
@@ -198,9 +209,7 @@ TEST(PdrMotion, ARunThatTurnsIsNotHandling) {
     feed(pdr, r, true);
     pdr.finish();
     const PdrCounters c = pdr.counters();
-    int in_span = 0;
-    for (const PdrStep& st : pdr.take_steps())
-      if (st.t_ns >= s_to_ns(run.from_s) && st.t_ns <= s_to_ns(run.to_s)) ++in_span;
+    const int in_span = steps_in_span(pdr, run);
     const double err_pct = 100.0 * (in_span - run.capture_steps) / run.capture_steps;
     std::printf("%-38s steps in the capture's span %d of %d (%+.1f %%), refused as handling %lld\n", run.name,
                 in_span, run.capture_steps, err_pct, static_cast<long long>(c.steps_discarded_by_motion));
@@ -215,13 +224,8 @@ TEST(PdrSteps, TheSwingOfAStrideIsReadFromTheGyroscope) {
   // a pendulum: its specific force stays along the arm, so the accelerometer's tilt moves a few
   // degrees while the phone turns +-15-25 deg; a phone held flat for texting sways those same
   // few degrees at every step of a slow walk. The angular rate tells them apart. TYREX, steps
-  // over the capture's span (tools/tyrex2log: texting 99 / 97, swinging with magnets 169).
-  struct Walk {
-    const char* name;
-    double from_s, to_s;
-    int capture_steps;
-  };
-  const auto run = [](const Walk& w, double min_rotation_radps, std::int64_t* added) {
+  // over the capture's span (texting 99 / 97, swinging with magnets 169).
+  const auto run = [](const CapturedWalk& w, double min_rotation_radps, std::int64_t* added) {
     const Recording r = read_tyrex(w.name);
     PdrOptions o;
     o.heading.mount = Mount::kAuto;
@@ -230,17 +234,15 @@ TEST(PdrSteps, TheSwingOfAStrideIsReadFromTheGyroscope) {
     feed(pdr, r, true);
     pdr.finish();
     *added = pdr.counters().steps_added_at_stride_midpoints;
-    int in_span = 0;
-    for (const PdrStep& st : pdr.take_steps())
-      if (st.t_ns >= s_to_ns(w.from_s) && st.t_ns <= s_to_ns(w.to_s)) ++in_span;
+    const int in_span = steps_in_span(pdr, w);
     std::printf("%-36s rotation test %s: %lld steps added at stride midpoints, %d of %d steps\n", w.name,
                 min_rotation_radps > 0.0 ? "on " : "off", static_cast<long long>(*added), in_span, w.capture_steps);
     return in_span;
   };
   // Texting (flat, 1.1-1.15 steps/s): the tilt test split 18 and 10 "strides" of 0.8-0.95 s,
   // i.e. single steps (Dist: 107 of 99 steps); the gyroscope splits none.
-  for (const Walk& w : {Walk{"Guillaume_Nexus5_Dist_Texting", 7.09, 121.59, 99},
-                        Walk{"Guillaume_Nexus5_NoDist_Texting", 7.46, 121.96, 97}}) {
+  for (const CapturedWalk& w : {CapturedWalk{"Guillaume_Nexus5_Dist_Texting", 7.09, 121.59, 99},
+                                CapturedWalk{"Guillaume_Nexus5_NoDist_Texting", 7.46, 121.96, 97}}) {
     SCOPED_TRACE(w.name);
     std::int64_t added_tilt = 0, added_gyro = 0;
     run(w, 0.0, &added_tilt);
@@ -250,7 +252,7 @@ TEST(PdrSteps, TheSwingOfAStrideIsReadFromTheGyroscope) {
   }
   // Swinging hand with magnets: one crossing per stride of 1.3-1.5 s for seconds at a time; the
   // tilt test split 9 of them (139 steps), the gyroscope 15 (145 steps).
-  const Walk swing{"Guillaume_Nexus5_Dist_Swinging", 6.44, 120.94, 169};
+  const CapturedWalk swing{"Guillaume_Nexus5_Dist_Swinging", 6.44, 120.94, 169};
   std::int64_t added_tilt = 0, added_gyro = 0;
   const int steps_tilt = run(swing, 0.0, &added_tilt);
   const int steps_gyro = run(swing, StepDetectorOptions{}.stride_min_rotation_radps, &added_gyro);

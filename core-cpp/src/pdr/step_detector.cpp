@@ -7,6 +7,38 @@
 
 namespace pdnav::pdr {
 
+namespace {
+
+/// How much a 3-vector series (the phone's tilt, or its angular rate) swings at 1/I and at
+/// 1/(2I) over the samples in [from, to]: single-bin DFTs of the series less its mean, as
+/// amplitudes 2|X|/n.
+struct SwingAmplitudes {
+  double at_interval = 0.0, at_half = 0.0;
+};
+template <typename Samples, typename Value>
+SwingAmplitudes swing_amplitudes(const Samples& samples, TimeNs from, TimeNs to, double interval_s, Value value) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (const auto& s : samples) {
+    if (s.t_ns < from || s.t_ns > to) continue;
+    mean += value(s);
+    ++n;
+  }
+  if (n == 0) return {};
+  mean /= n;
+  Eigen::Vector3cd x1 = Eigen::Vector3cd::Zero(), xh = Eigen::Vector3cd::Zero();
+  for (const auto& s : samples) {
+    if (s.t_ns < from || s.t_ns > to) continue;
+    const double ph = 2.0 * kPi * ns_to_s(s.t_ns - to) / interval_s;
+    const Eigen::Vector3d d = value(s) - mean;
+    x1 += d.cast<std::complex<double>>() * std::polar(1.0, -ph);
+    xh += d.cast<std::complex<double>>() * std::polar(1.0, -0.5 * ph);
+  }
+  return {2.0 * x1.norm() / n, 2.0 * xh.norm() / n};
+}
+
+}  // namespace
+
 SampleCheck check_sample(TimeNs t_ns, bool finite, TimeNs last_t_ns, bool have_last, double gap_reset_s,
                          SampleCounters& counters) {
   if (!finite) {
@@ -149,45 +181,36 @@ bool StepDetector::stride_like(TimeNs t_ns, double interval_s) const {
     return false;
   }
   // Single-bin DFTs over the last two intervals (whole cycles, so the bins are orthogonal):
-  // |a| at f1 = 1/I (stride) and f2 = 2/I (step); the tilt direction at f1 and at f1/2.
+  // |a| at f1 = 1/I (stride) and f2 = 2/I (step); then the swing at f1 and at f1/2.
   const TimeNs from = t_ns - s_to_ns(2.0 * interval_s);
   double mean = 0.0;
-  Eigen::Vector3d mean_dir = Eigen::Vector3d::Zero();
   int n = 0;
   for (const auto& h : history_) {
     if (h.t_ns < from) continue;
     mean += h.value;
-    mean_dir += h.dir;
     ++n;
   }
   if (n < 8) return false;
   mean /= n;
-  mean_dir /= n;
   std::complex<double> x1 = 0.0, x2 = 0.0;
-  Eigen::Vector3cd d1 = Eigen::Vector3cd::Zero(), dh = Eigen::Vector3cd::Zero();
   for (const auto& h : history_) {
     if (h.t_ns < from) continue;
     const double ph = 2.0 * kPi * ns_to_s(h.t_ns - t_ns) / interval_s;
-    const std::complex<double> e1 = std::polar(1.0, -ph), e2 = std::polar(1.0, -2.0 * ph), eh = std::polar(1.0, -0.5 * ph);
-    x1 += (h.value - mean) * e1;
-    x2 += (h.value - mean) * e2;
-    const Eigen::Vector3d dd = h.dir - mean_dir;
-    d1 += dd.cast<std::complex<double>>() * e1;
-    dh += dd.cast<std::complex<double>>() * eh;
+    x1 += (h.value - mean) * std::polar(1.0, -ph);
+    x2 += (h.value - mean) * std::polar(1.0, -2.0 * ph);
   }
   const double a1 = std::abs(x1);
   const double step_power = a1 > 0.0 ? std::abs(x2) / a1 : 0.0;
   if (step_power <= opt_.stride_harmonic_ratio) return false;
   if (const std::optional<bool> rotates = rotates_at(t_ns, interval_s)) return *rotates;
-  const double tilt_1 = 2.0 * d1.norm() / n;  // amplitude (rad, small-angle) at 1/I
-  const double tilt_half = 2.0 * dh.norm() / n;
-  return tilt_1 > opt_.stride_min_tilt_rad && tilt_1 > tilt_half;
+  // No gyroscope over the intervals: the tilt (rad, small-angle).
+  const SwingAmplitudes tilt = swing_amplitudes(history_, from, t_ns, interval_s, [](const Tilted& h) { return h.dir; });
+  return tilt.at_interval > opt_.stride_min_tilt_rad && tilt.at_interval > tilt.at_half;
 }
 
 std::optional<bool> StepDetector::rotates_at(TimeNs t_ns, double interval_s) const {
   const TimeNs from = t_ns - s_to_ns(2.0 * interval_s);
   const TimeNs slack = s_to_ns(0.25 * interval_s);
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   TimeNs first = 0, last = 0, widest_gap = 0;
   int n = 0;
   for (const auto& r : rates_) {
@@ -195,23 +218,12 @@ std::optional<bool> StepDetector::rotates_at(TimeNs t_ns, double interval_s) con
     if (n == 0) first = r.t_ns;
     else widest_gap = std::max(widest_gap, r.t_ns - last);
     last = r.t_ns;
-    mean += r.rate_radps;
     ++n;
   }
   // The samples must cover the two intervals (no batch still to come, no hole in the stream).
   if (n < 8 || first - from > slack || t_ns - last > slack || widest_gap > slack) return std::nullopt;
-  mean /= n;
-  // Single-bin DFTs of the angular rate (3 axes) at 1/I and 1/(2I), as for |a| above.
-  Eigen::Vector3cd r1 = Eigen::Vector3cd::Zero(), rh = Eigen::Vector3cd::Zero();
-  for (const auto& r : rates_) {
-    if (r.t_ns < from || r.t_ns > t_ns) continue;
-    const double ph = 2.0 * kPi * ns_to_s(r.t_ns - t_ns) / interval_s;
-    const Eigen::Vector3d w = r.rate_radps - mean;
-    r1 += w.cast<std::complex<double>>() * std::polar(1.0, -ph);
-    rh += w.cast<std::complex<double>>() * std::polar(1.0, -0.5 * ph);
-  }
-  const double rot_1 = 2.0 * r1.norm() / n, rot_half = 2.0 * rh.norm() / n;  // amplitudes, rad/s
-  return rot_1 > opt_.stride_min_rotation_radps && rot_1 > rot_half;
+  const SwingAmplitudes rot = swing_amplitudes(rates_, from, t_ns, interval_s, [](const Rate& r) { return r.rate_radps; });
+  return rot.at_interval > opt_.stride_min_rotation_radps && rot.at_interval > rot.at_half;  // rad/s
 }
 
 void StepDetector::feed(const GyroSample& s) {
