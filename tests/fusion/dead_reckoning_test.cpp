@@ -149,7 +149,7 @@ double scale_coverage(double walker_scale, std::uint32_t seed, const fusion::Dea
 }  // namespace
 
 TEST(DeadReckoning, StepScaleErrorOfTheWalkerIsCovered) {
-  // A walker whose steps are 15 % shorter than the model is 1.5 sigma of the 10 % population
+  // A walker whose steps are 15 % shorter than the model is 0.8 sigma of the 18 % population
   // prior: inside the 95 % ellipse (chi^2(2): 5.99) nearly always. With the scale treated as
   // white per step (length_scale_sigma = 0, before issue 28) the along-track error (15 % of the
   // distance) outgrows the ellipse (5 % per step averages out as sqrt(N)) within ~100 steps.
@@ -163,7 +163,7 @@ TEST(DeadReckoning, StepScaleErrorOfTheWalkerIsCovered) {
     EXPECT_GT(c, 0.95) << seed;
     EXPECT_LT(w, 0.05) << seed;
   }
-  // Walkers drawn from the prior itself (scale ~ N(1, 0.10), 40 fixed seeds): pooled 1-sigma
+  // Walkers drawn from the prior itself (scale ~ N(1, length_scale_sigma), 40 fixed seeds): pooled 1-sigma
   // coverage near the Rayleigh 39 % (30-50 %); white: far below.
   std::mt19937 rng(28);
   std::normal_distribution<double> prior(1.0, with_scale.length_scale_sigma);

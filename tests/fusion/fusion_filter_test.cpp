@@ -205,7 +205,7 @@ TEST(FusionFilter, HeadingBiasVarianceAfterAWindowFollowsTheGaussMarkovModel) {
 // what wanders is the scale within the walk (scale_within_walk_sigma), and the calibration's
 // knowledge fades to that, at the rate the window fit's own variance predicts.
 TEST(FusionFilter, ScaleErrorFadesBackToTheWithinWalkSigmaAsAGaussMarkovProcess) {
-  FusionFilter f;  // scale_tau_s 300 s, initial_scale_sigma 0.15, scale_within_walk_sigma 0.10
+  FusionFilter f;  // scale_tau_s 300 s, initial_scale_sigma 0.18, scale_within_walk_sigma 0.10
   const double tau = f.options().scale_tau_s, prior2 = std::pow(f.options().initial_scale_sigma, 2),
                walk2 = std::pow(f.options().scale_within_walk_sigma, 2);
   ASSERT_GT(tau, 0.0);

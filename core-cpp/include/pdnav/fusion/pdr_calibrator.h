@@ -27,9 +27,9 @@ struct PdrCalibrationOptions {
   bool check_bias_drift = true;       // fit the two halves of the window: how far the bias moved
   bool independent_heading = true;    // false: one publication test on both sigmas (before issue 28)
   /// Published when it knows the scale and the heading bias better than the fused filter's
-  /// prior (15 %, 10 deg: FusionFilterOptions); the filter then carries the fit's own sigmas,
+  /// prior (18 %, 10 deg: FusionFilterOptions); the filter then carries the fit's own sigmas,
   /// so a less certain calibration is used with its honest uncertainty.
-  double max_scale_sigma = 0.15;
+  double max_scale_sigma = 0.18;
   double max_heading_bias_sigma_rad = 10.0 * kDegToRad;
   double prior_heading_bias_sigma_rad = 10.0 * kDegToRad;  // = FusionFilterOptions::initial_heading_bias_sigma_rad
   double min_scale = 0.5, max_scale = 1.8;  // a fit outside is not a calibration (wrong data)
