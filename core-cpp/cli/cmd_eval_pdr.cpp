@@ -32,6 +32,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
@@ -164,6 +165,10 @@ struct WalkResult {
   double rms_pct = kNaN, naive_rms_pct = kNaN, still_rms_pct = kNaN;  // RMS error / truth path, % (aligned)
   double align_deg = kNaN, naive_align_deg = kNaN;  // --align-start-s: rotation applied to the track
   std::int64_t samples_dropped_by_sensor_set = 0;
+  // the estimate's stated covariance against its error (+ the reference's own, for fixes):
+  // scored points with a covariance, inside the 68 % region (d^2 <= 2.279), inside 1 sigma (d^2 <= 1)
+  std::int64_t cov_scored = 0, cov_inside_68 = 0, cov_inside_1sigma = 0;
+  std::map<TimeNs, double> ref_sigma_m;  // --reference fixes: per-axis 1-sigma of each fix
 };
 
 double median(std::vector<double> v) {
@@ -294,6 +299,7 @@ class Runner {
     if (nav_) {
       const Estimate e = nav_->estimate();
       if (!e.valid()) return std::nullopt;
+      cov_ = e.cov_en_m2;
       const Eigen::Vector2d p = frame_.to_enu(e.position).p_m.head<2>();
       path_m_ += (p - last_en_).norm();
       last_en_ = p;
@@ -302,6 +308,8 @@ class Runner {
     return en_;
   }
   double path_m() const { return path_m_; }
+  /// The last estimate's stated covariance (the Navigator; a direct Pdr states none).
+  std::optional<Eigen::Matrix2d> covariance() const { return cov_; }
   std::int64_t steps() const { return nav_ ? nav_->output(0).steps : steps_; }
   /// Each emitted step's own time (the dead-reckoning estimate's time after it).
   const std::vector<TimeNs>& step_times() const { return step_times_; }
@@ -324,6 +332,7 @@ class Runner {
   double path_m_ = 0;
   std::int64_t steps_ = 0;
   std::vector<TimeNs> step_times_;
+  std::optional<Eigen::Matrix2d> cov_;
 };
 
 /// Heading error of an estimated displacement against the surveyed segment, degrees, + =
@@ -423,6 +432,7 @@ std::vector<Sample> fixes_as_reference(const std::vector<Sample>& in, double max
     t.lon_deg = f->lon_deg;
     t.h_m = f->alt_m;
     out.push_back(t);
+    r.ref_sigma_m[t.t_ns] = f->accuracy_m / 1.51;  // Android accuracy = 68 % radius -> per-axis sigma
     ++r.fixes_used;
   }
   return out;
@@ -494,6 +504,17 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
       naive_path_m += (naive.pos_en() - naive_last).norm();
       naive_last = naive.pos_en();
       r.errors_m.push_back((est - tr).norm());
+      if (const auto cov = run.covariance(); p && cov && cov->allFinite()) {
+        Eigen::Matrix2d c = *cov;
+        if (const auto it = r.ref_sigma_m.find(t->t_ns); it != r.ref_sigma_m.end())
+          c += it->second * it->second * Eigen::Matrix2d::Identity();
+        c += 1e-6 * Eigen::Matrix2d::Identity();
+        const Eigen::Vector2d d = est - tr;
+        const double d2 = d.dot(c.ldlt().solve(d));
+        ++r.cov_scored;
+        r.cov_inside_68 += d2 <= 2.2788;
+        r.cov_inside_1sigma += d2 <= 1.0;
+      }
       r.naive_errors_m.push_back((naive.pos_en() - tr).norm());
       r.still_errors_m.push_back(tr.norm());
       seg_path_m += (tr - truth_en.back()).norm();
@@ -641,6 +662,9 @@ nlohmann::json walk_json(const WalkResult& r, const EvalPdrArgs& a) {
   j["naive_rms_pct"] = num(r.naive_rms_pct);
   j["still_rms_pct"] = num(r.still_rms_pct);
   j["align_deg"] = num(r.align_deg);
+  j["cov_scored"] = r.cov_scored;
+  j["coverage_68"] = r.cov_scored > 0 ? num(static_cast<double>(r.cov_inside_68) / static_cast<double>(r.cov_scored)) : nlohmann::json(nullptr);
+  j["coverage_1sigma"] = r.cov_scored > 0 ? num(static_cast<double>(r.cov_inside_1sigma) / static_cast<double>(r.cov_scored)) : nlohmann::json(nullptr);
   j["naive_align_deg"] = num(r.naive_align_deg);
   return j;
 }
@@ -725,6 +749,12 @@ int run_eval_pdr(const EvalPdrArgs& a) {
                 a.wave_s, static_cast<unsigned long long>(a.wave_seed), a.wave_amplitude, median(ws),
                 percentile(ws, 100), over, all.size(), median(nws));
   }
+  std::int64_t cs = 0, c68 = 0, c1 = 0;
+  for (const auto& r : all) cs += r.cov_scored, c68 += r.cov_inside_68, c1 += r.cov_inside_1sigma;
+  if (cs > 0)
+    std::printf("stated covariance (pooled over %lld scored points): inside the 68 %% region %.3f, inside 1 sigma %.3f (2-D Gaussian: 0.68, 0.39)\n",
+                static_cast<long long>(cs), static_cast<double>(c68) / static_cast<double>(cs),
+                static_cast<double>(c1) / static_cast<double>(cs));
   std::printf("per-walk mean error: p25 %.2f m, p75 %.2f m, max %.2f m\n", percentile(means, 25), percentile(means, 75),
               percentile(means, 100));
   std::printf("median_mean_error_m: %.2f median_length_ratio: %.3f\n", median(means), median(ratios));
