@@ -316,23 +316,36 @@ void Pdr::settle_vehicle_wait(TimeNs now_ns, bool force) {
 }
 
 void Pdr::deliver_walking(HeldStep h, TimeNs now_ns) {
+  // A step of the current bout waits for the bout's walking direction, and so does a step taken
+  // before its bout started (hold(): it belongs to the next bout): going out now it would take
+  // the previous bout's direction, which the phone moved since (a handling ends a bout).
   const bool wait = opt_.heading.mount == Mount::kAuto && opt_.placement.max_direction_wait_s > 0.0 &&
-                    h.placement_revision == placement_.revision() && !placement_.direction_known();
+                    (h.placement_revision > placement_.revision() ||
+                     (h.placement_revision == placement_.revision() && !placement_.direction_known()));
   if (wait) {
     undecided_.push_back(h);
     return;
   }
   flush_undecided(now_ns, true);
+  emit_walking(h);
+}
+
+void Pdr::emit_walking(const HeldStep& h) {
+  // out before its own bout began (the wait ran out): it carries the previous bout's direction
+  if (opt_.heading.mount == Mount::kAuto && h.placement_revision > placement_.revision())
+    ++counters_.steps_before_their_bouts_direction;
   emit_step(reprojected(h));
 }
 
 void Pdr::flush_undecided(TimeNs now_ns, bool force) {
   if (undecided_.empty()) return;
-  const bool decided = placement_.direction_known() || undecided_.front().placement_revision != placement_.revision();
+  // decided: the step's bout knows its direction, or it has ended (its last estimate is all there is)
+  const std::int64_t rev = undecided_.front().placement_revision;
+  const bool decided = rev < placement_.revision() || (rev == placement_.revision() && placement_.direction_known());
   const bool too_old = ns_to_s(now_ns - undecided_.front().candidate.t_ns) > opt_.placement.max_direction_wait_s;
   if (!force && !decided && !too_old) return;
   while (!undecided_.empty()) {
-    emit_step(reprojected(undecided_.front()));
+    emit_walking(undecided_.front());
     undecided_.pop_front();
   }
 }

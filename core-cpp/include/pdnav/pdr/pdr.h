@@ -91,6 +91,9 @@ struct PdrCounters {
   std::int64_t steps_discarded_by_motion = 0;  // candidates while the phone was handled/waved
   std::int64_t steps_discarded_by_vehicle = 0;  // steps inside a vehicle span (car, bus, train)
   std::int64_t steps_added_at_stride_midpoints = 0;  // swinging hand / running strides split (stage 4)
+  /// Steps emitted before the placement bout they belong to had begun (its walking direction
+  /// was waited for max_direction_wait_s in vain): they carry the previous bout's direction.
+  std::int64_t steps_before_their_bouts_direction = 0;
   std::int64_t mag_readings_trusted = 0;       // absolute headings that passed the WMM tests
   std::int64_t mag_readings_disturbed = 0;     // ... and that failed them (down-weighted)
   std::int64_t mag_readings_qsf_tested = 0;    // magnetometer readings tested for a quasi-static field
@@ -236,6 +239,9 @@ class Pdr {
   }
   void flush_undecided(TimeNs now_ns, bool force);
   HeldStep reprojected(HeldStep h) const;
+  /// Emits a walking step with its bout's latest direction (reprojected), counting one that goes
+  /// out before its bout began (PdrCounters::steps_before_their_bouts_direction).
+  void emit_walking(const HeldStep& h);
   void emit_step(const HeldStep& h);
   bool android_active(TimeNs t_ns) const;
   void trim_consistency(TimeNs t_ns);
