@@ -208,12 +208,12 @@ WalkResult evaluate(const phonesim::PhoneSession& ses, const fusion::NavigatorCo
   }
   r.outage_ratio = r.out[0].drms_m / r.out[1].drms_m;
   // Consistency of the fused covariance in the outage: truth inside its 68.27 % ellipse
-  // (Mahalanobis^2 <= 2.2958; docs/results.md "Coverage definitions").
+  // (Mahalanobis^2 <= kOneSigmaM2; docs/results.md "Coverage definitions").
   for (const std::size_t k : out_idx) {
     if (k >= fused.valid.size() || !fused.valid[k]) continue;
     ++r.out_scored;
-    const double m2 = terrain::mahalanobis2(fused.cov[k], fused.en_m[k] - truth[k].en_m);
-    if (std::isfinite(m2) && m2 <= 2.2958) ++r.out_covered_68;
+    const double m2 = mahalanobis2(fused.cov[k], fused.en_m[k] - truth[k].en_m);
+    if (std::isfinite(m2) && m2 <= kOneSigmaM2) ++r.out_covered_68;
   }
   r.open_sky_ratio = r.open[0].drms_m / r.open[2].drms_m;
   // Largest jump of the shown position between consecutive epochs, beyond the true motion,
@@ -221,7 +221,7 @@ WalkResult evaluate(const phonesim::PhoneSession& ses, const fusion::NavigatorCo
   for (std::size_t k = 1; k < n; ++k) {
     if (!fused.valid[k] || !fused.valid[k - 1]) continue;
     const Eigen::Vector2d d = (fused.en_m[k] - fused.en_m[k - 1]) - (truth[k].en_m - truth[k - 1].en_m);
-    const double m2 = terrain::mahalanobis2(fused.cov[k] + fused.cov[k - 1], d);
+    const double m2 = mahalanobis2(fused.cov[k] + fused.cov[k - 1], d);
     r.max_jump_sigma = std::max(r.max_jump_sigma, std::isfinite(m2) ? std::sqrt(m2) : 1e9);
   }
   // Re-convergence: first epoch after GNSS returns from which, for 30 s (or to the walk's end),

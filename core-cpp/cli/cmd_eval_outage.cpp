@@ -37,8 +37,6 @@ namespace pdnav::cli {
 namespace {
 
 constexpr double kNaNd = std::numeric_limits<double>::quiet_NaN();
-constexpr double kChi2_2dof_68 = 2.2958;   // 68.27 % region of a 2-D Gaussian (Mahalanobis^2)
-constexpr double kAccuracyToSigma = 1.0 / 1.51;  // Android accuracy (68 % radius) -> 1-sigma per axis
 constexpr double kJumpAfterS = 60.0;       // re-acquisition jumps are looked for this long after the window
 
 struct EvalOutageArgs {
@@ -109,9 +107,6 @@ std::string calibration_note(const fusion::PdrCalibration& c) {
 
 bool is_gnss(const Sample& s) { return std::holds_alternative<GnssRawSample>(s) || std::holds_alternative<FixSample>(s); }
 
-double fix_sigma(const FixSample& f) {
-  return (std::isfinite(f.accuracy_m) && f.accuracy_m > 0.0 ? f.accuracy_m : 15.0) * kAccuracyToSigma;
-}
 
 std::string f1(double v) { return fixed_or(v, 1, "nan"); }
 std::string f3(double v) { return fixed_or(v, 3, "nan"); }
@@ -207,7 +202,7 @@ WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std:
     while (reader.next(s)) {
       const TimeNs t = sample_time_ns(s);
       if (const auto* f = std::get_if<FixSample>(&s); f && is_gps_reference_fix(*f))
-        fixes.push_back({t, geo::Geodetic::from_deg(f->lat_deg, f->lon_deg, 0.0), fix_sigma(*f)});
+        fixes.push_back({t, geo::Geodetic::from_deg(f->lat_deg, f->lon_deg, 0.0), fix_sigma_m(*f)});
       if (const auto* tr = std::get_if<TruthSample>(&s); tr && std::isfinite(tr->lat_deg) && std::isfinite(tr->lon_deg))
         truth.push_back({t, geo::Geodetic::from_deg(tr->lat_deg, tr->lon_deg, 0.0), 0.0});
       if (is_gnss(s)) {
@@ -282,14 +277,14 @@ WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std:
     if (fused.valid[k]) {
       const Eigen::Vector2d e = fused.en_m[k] - ref_en[k];
       const Eigen::Matrix2d c = fused.cov[k] + refs[k].sigma_m * refs[k].sigma_m * Eigen::Matrix2d::Identity();
-      if (c.determinant() > 0.0) m2[k] = e.dot(c.inverse() * e);
+      if (c.determinant() > 0.0) m2[k] = mahalanobis2(c, e);
     }
     if (refs[k].t_ns < w0 || refs[k].t_ns >= w1) continue;
     ++r.epochs_in_window;
     if (fused.valid[k]) {
       const double e = (fused.en_m[k] - ref_en[k]).norm();
       s_f += e * e, ++n_f, r.fused_end_m = e;
-      if (std::isfinite(m2[k]) && m2[k] <= kChi2_2dof_68) ++r.covered;
+      if (std::isfinite(m2[k]) && m2[k] <= kOneSigmaM2) ++r.covered;
     }
     if (dr.valid[k]) {
       const double e = (dr.en_m[k] - ref_en[k]).norm();
@@ -307,7 +302,8 @@ WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std:
     if (!fused.valid[k] || !fused.valid[k - 1]) continue;
     const Eigen::Vector2d d = (fused.en_m[k] - fused.en_m[k - 1]) - (ref_en[k] - ref_en[k - 1]);
     const Eigen::Matrix2d c = fused.cov[k] + fused.cov[k - 1];
-    const double j = c.determinant() > 0.0 ? std::sqrt(std::max(0.0, d.dot(c.inverse() * d))) : 1e9;
+    const double m = mahalanobis2(c, d);
+    const double j = std::isfinite(m) ? std::sqrt(std::max(0.0, m)) : 1e9;
     if (j > r.max_jump_sigma) r.max_jump_sigma = j, r.max_jump_t_s = static_cast<double>(refs[k].t_ns - g0) * 1e-9;
   }
 

@@ -32,7 +32,6 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
-#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
@@ -166,7 +165,7 @@ struct WalkResult {
   double align_deg = kNaN, naive_align_deg = kNaN;  // --align-start-s: rotation applied to the track
   std::int64_t samples_dropped_by_sensor_set = 0;
   // the estimate's stated covariance against its error (+ the reference's own, for fixes):
-  // scored points with a covariance, inside the 68 % region (d^2 <= 2.279), inside 1 sigma (d^2 <= 1)
+  // scored points with a covariance, inside the 68 % region (kOneSigmaM2), inside 1 sigma (d^2 <= 1)
   std::int64_t cov_scored = 0, cov_inside_68 = 0, cov_inside_1sigma = 0;
   std::map<TimeNs, double> ref_sigma_m;  // --reference fixes: per-axis 1-sigma of each fix
 };
@@ -432,7 +431,7 @@ std::vector<Sample> fixes_as_reference(const std::vector<Sample>& in, double max
     t.lon_deg = f->lon_deg;
     t.h_m = f->alt_m;
     out.push_back(t);
-    r.ref_sigma_m[t.t_ns] = f->accuracy_m / 1.51;  // Android accuracy = 68 % radius -> per-axis sigma
+    r.ref_sigma_m[t.t_ns] = fix_sigma_m(*f);
     ++r.fixes_used;
   }
   return out;
@@ -508,11 +507,9 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
         Eigen::Matrix2d c = *cov;
         if (const auto it = r.ref_sigma_m.find(t->t_ns); it != r.ref_sigma_m.end())
           c += it->second * it->second * Eigen::Matrix2d::Identity();
-        c += 1e-6 * Eigen::Matrix2d::Identity();
-        const Eigen::Vector2d d = est - tr;
-        const double d2 = d.dot(c.ldlt().solve(d));
+        const double d2 = mahalanobis2(c, est - tr);
         ++r.cov_scored;
-        r.cov_inside_68 += d2 <= 2.2788;
+        r.cov_inside_68 += d2 <= kOneSigmaM2;
         r.cov_inside_1sigma += d2 <= 1.0;
       }
       r.naive_errors_m.push_back((naive.pos_en() - tr).norm());

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -68,6 +69,16 @@ void feed(Pdr& pdr, const Recording& r, bool with_gyro, TimeNs until_ns = std::n
     while (with_gyro && g < r.gyro.size() && r.gyro[g].t_ns <= a.t_ns) pdr.feed(r.gyro[g++]);
     pdr.feed(a);
   }
+}
+
+/// A whole TYREX recording (accelerometer and gyroscope) through a Pdr in auto mount, finished.
+std::unique_ptr<Pdr> replayed(const std::string& name, PdrOptions o = {}) {
+  o.heading.mount = Mount::kAuto;
+  const Recording r = read_tyrex(name);
+  auto pdr = std::make_unique<Pdr>(o);
+  feed(*pdr, r, true);
+  pdr->finish();
+  return pdr;
 }
 
 /// A TYREX recording with the step count of its motion capture and the span that count covers
@@ -202,14 +213,9 @@ TEST(PdrMotion, ARunThatTurnsIsNotHandling) {
   std::int64_t refused = 0;
   for (const CapturedWalk& run : runs) {
     SCOPED_TRACE(run.name);
-    const Recording r = read_tyrex(run.name);
-    PdrOptions o;
-    o.heading.mount = Mount::kAuto;
-    Pdr pdr(o);
-    feed(pdr, r, true);
-    pdr.finish();
-    const PdrCounters c = pdr.counters();
-    const int in_span = steps_in_span(pdr, run);
+    const auto pdr = replayed(run.name);
+    const PdrCounters c = pdr->counters();
+    const int in_span = steps_in_span(*pdr, run);
     const double err_pct = 100.0 * (in_span - run.capture_steps) / run.capture_steps;
     std::printf("%-38s steps in the capture's span %d of %d (%+.1f %%), refused as handling %lld\n", run.name,
                 in_span, run.capture_steps, err_pct, static_cast<long long>(c.steps_discarded_by_motion));
@@ -226,15 +232,11 @@ TEST(PdrSteps, TheSwingOfAStrideIsReadFromTheGyroscope) {
   // few degrees at every step of a slow walk. The angular rate tells them apart. TYREX, steps
   // over the capture's span (texting 99 / 97, swinging with magnets 169).
   const auto run = [](const CapturedWalk& w, double min_rotation_radps, std::int64_t* added) {
-    const Recording r = read_tyrex(w.name);
     PdrOptions o;
-    o.heading.mount = Mount::kAuto;
     o.detector.stride_min_rotation_radps = min_rotation_radps;
-    Pdr pdr(o);
-    feed(pdr, r, true);
-    pdr.finish();
-    *added = pdr.counters().steps_added_at_stride_midpoints;
-    const int in_span = steps_in_span(pdr, w);
+    const auto pdr = replayed(w.name, o);
+    *added = pdr->counters().steps_added_at_stride_midpoints;
+    const int in_span = steps_in_span(*pdr, w);
     std::printf("%-36s rotation test %s: %lld steps added at stride midpoints, %d of %d steps\n", w.name,
                 min_rotation_radps > 0.0 ? "on " : "off", static_cast<long long>(*added), in_span, w.capture_steps);
     return in_span;
@@ -271,17 +273,12 @@ TEST(PdrDirection, AStepTakenBeforeItsBoutBeganWaitsForThatBoutsDirection) {
                                "Guillaume_Nexus5_NoDist_BackPocket", "Guillaume_Nexus5_Dist_Phoning"};
   for (const char* name : names) {
     SCOPED_TRACE(name);
-    const Recording r = read_tyrex(name);
-    PdrOptions o;
-    o.heading.mount = Mount::kAuto;
-    Pdr pdr(o);
-    feed(pdr, r, true);
-    pdr.finish();
-    const PdrCounters c = pdr.counters();
+    const auto pdr = replayed(name);
+    const PdrCounters c = pdr->counters();
     std::printf("%-38s %zu steps, %lld out before their bout's direction, longest wait %.2f s\n", name,
-                pdr.take_steps().size(), static_cast<long long>(c.steps_before_their_bouts_direction),
+                pdr->take_steps().size(), static_cast<long long>(c.steps_before_their_bouts_direction),
                 c.max_step_delay_s);
     EXPECT_EQ(c.steps_before_their_bouts_direction, 0);
-    EXPECT_LE(c.max_step_delay_s, o.placement.max_direction_wait_s + 0.5);  // the wait stays bounded
+    EXPECT_LE(c.max_step_delay_s, PlacementOptions{}.max_direction_wait_s + 0.5);  // the wait stays bounded
   }
 }

@@ -60,6 +60,11 @@ nlohmann::json ErrorStats::to_json() const {
           {"p50_horizontal_m", p50_h_m}, {"p95_horizontal_m", p95_h_m}, {"coverage_1sigma", coverage_1sigma}, {"coverage_68", coverage_68}};
 }
 
+double fix_sigma_m(const FixSample& f, double default_accuracy_m) {
+  return (std::isfinite(f.accuracy_m) && f.accuracy_m > 0.0 ? f.accuracy_m : default_accuracy_m) *
+         (1.0 / FixSample::kAccuracyRadiusPerSigma);
+}
+
 bool is_gps_reference_fix(const FixSample& f) {
   std::string p = f.provider;
   std::transform(p.begin(), p.end(), p.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
@@ -129,10 +134,8 @@ void ReplayRecorder::finish() {
     const geo::Enu d = geo::LocalFrame(ref).to_enu(ep.est.position);
     ep.err_e_m = d.e_m();
     ep.err_n_m = d.n_m();
-    const Eigen::Vector2d err(ep.err_e_m, ep.err_n_m);
-    const Eigen::Matrix2d cov = ep.est.cov_en_m2;
     // inside the 1-sigma ellipse: Mahalanobis distance^2 <= 1 (39.3 % nominal in 2D)
-    ep.mahalanobis2 = cov.determinant() > 0 ? err.dot(cov.inverse() * err) : std::numeric_limits<double>::infinity();
+    ep.mahalanobis2 = mahalanobis2(ep.est.cov_en_m2, Eigen::Vector2d(ep.err_e_m, ep.err_n_m));
     ep.inside_1sigma = ep.mahalanobis2 <= 1.0;
   }
 }
@@ -154,7 +157,6 @@ ErrorStats ReplayRecorder::error_stats() const {
   std::vector<double> h;
   double se = 0, sn = 0;
   std::int64_t inside = 0, inside68 = 0;
-  const double k68 = -2.0 * std::log(1.0 - 0.6827);  // 2.2958
   for (const Epoch& e : epochs_) {
     if (!e.has_ref) continue;
     ++s.n;
@@ -162,7 +164,7 @@ ErrorStats ReplayRecorder::error_stats() const {
     sn += e.err_n_m * e.err_n_m;
     h.push_back(std::hypot(e.err_e_m, e.err_n_m));
     inside += e.inside_1sigma ? 1 : 0;
-    inside68 += e.mahalanobis2 <= k68 ? 1 : 0;
+    inside68 += e.mahalanobis2 <= kOneSigmaM2 ? 1 : 0;
   }
   if (s.n == 0) return s;
   const double n = static_cast<double>(s.n);

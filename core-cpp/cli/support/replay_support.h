@@ -43,9 +43,13 @@ struct ErrorStats {
   double p50_h_m = 0.0;
   double p95_h_m = 0.0;
   double coverage_1sigma = 0.0;  // inside the 1-sigma ellipse (Mahalanobis <= 1; 39.3 % if consistent)
-  double coverage_68 = 0.0;      // inside the 68.27 % ellipse (Mahalanobis^2 <= 2.2958; 68.3 % if consistent)
+  double coverage_68 = 0.0;      // inside the 68.27 % ellipse (Mahalanobis^2 <= kOneSigmaM2; 68.3 % if consistent)
   nlohmann::json to_json() const;
 };
+
+/// Per-axis 1-sigma (m) of a reference fix: its stated accuracy (the 68 % radius,
+/// FixSample::kAccuracyRadiusPerSigma), or default_accuracy_m when it states none.
+double fix_sigma_m(const FixSample& f, double default_accuracy_m = 15.0);
 
 /// A Fix row that is a reference position (replay's error figures, eval-outage, eval-pdr
 /// --reference fixes): provider GPS (any case; network and fused fixes are not), finite

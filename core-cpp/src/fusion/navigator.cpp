@@ -585,7 +585,7 @@ struct Navigator::Impl {
   void fused_fix(const FixSample& f) {
     if (last_raw_pos_ns >= 0 && f.t_ns - last_raw_pos_ns <= ns(fo().fix_fallback_after_s)) return;  // Raw is better
     const double acc = std::isfinite(f.accuracy_m) && f.accuracy_m > 0 ? f.accuracy_m : fo().fix_default_accuracy_m;
-    const double sigma = acc / 1.51 * fo().fix_sigma_scale;  // 68 % radius -> 1-sigma per axis
+    const double sigma = acc / FixSample::kAccuracyRadiusPerSigma * fo().fix_sigma_scale;  // 68 % radius -> 1-sigma per axis
     const geo::Geodetic g = geo::Geodetic::from_deg(f.lat_deg, f.lon_deg, std::isfinite(f.alt_m) ? f.alt_m : 0.0);
     const Eigen::Vector2d z = frame.to_enu(g).p_m.head<2>();
     const Eigen::Vector2d before = ff.position_en_m();

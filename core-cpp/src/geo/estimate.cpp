@@ -1,6 +1,7 @@
 #include "pdnav/geo/estimate.h"
 
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Eigenvalues>
 
@@ -48,5 +49,12 @@ ErrorEllipse ErrorEllipse::from_covariance(const Eigen::Matrix2d& cov) {
 }
 
 double ErrorEllipse::scale_for_probability(double p) { return std::sqrt(-2.0 * std::log(1.0 - p)); }
+
+double mahalanobis2(const Eigen::Matrix2d& cov, const Eigen::Vector2d& d) {
+  const double a = cov(0, 0), b = 0.5 * (cov(0, 1) + cov(1, 0)), c = cov(1, 1);
+  const double det = a * c - b * b;
+  if (!(det > 0.0) || !(a > 0.0)) return std::numeric_limits<double>::infinity();
+  return (c * d.x() * d.x() - 2.0 * b * d.x() * d.y() + a * d.y() * d.y()) / det;
+}
 
 }  // namespace pdnav

@@ -136,13 +136,6 @@ std::vector<RoutePoint> make_route(const Dem& dem, const WalkSimOptions& o, doub
 
 }  // namespace
 
-double mahalanobis2(const Eigen::Matrix2d& cov, const Eigen::Vector2d& d) {
-  const double a = cov(0, 0), b = 0.5 * (cov(0, 1) + cov(1, 0)), c = cov(1, 1);
-  const double det = a * c - b * b;
-  if (!(det > 0.0) || !(a > 0.0)) return std::numeric_limits<double>::infinity();
-  return (c * d.x() * d.x() - 2.0 * b * d.x() * d.y() + a * d.y() * d.y()) / det;
-}
-
 std::uint64_t walk_seed(std::uint64_t base_seed, std::uint64_t k) {
   std::uint64_t x = base_seed * 0x100000001B3ULL + k;
   return detail::splitmix64(x);

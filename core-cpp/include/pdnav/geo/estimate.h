@@ -31,6 +31,15 @@ struct ErrorEllipse {
   static double scale_for_probability(double p);
 };
 
+/// The 2-D "1-sigma" region holds the probability of +-1 sigma in 1-D, 68.27 %:
+/// Mahalanobis^2 <= -2 ln(1 - 0.682689) = 2.2957 (ErrorEllipse::scale_for_probability(0.6827)^2).
+/// Every coverage_68 figure (replay, eval-outage, eval-fusion, eval-pdr, the terrain evaluation).
+inline constexpr double kOneSigmaM2 = 2.295748928898636;
+
+/// Squared Mahalanobis distance d' cov^-1 d of a 2-D offset (inf when cov is not positive definite);
+/// <= 1 means inside the 1-sigma ellipse.
+double mahalanobis2(const Eigen::Matrix2d& cov, const Eigen::Vector2d& d);
+
 struct Estimate {
   TimeNs t_ns = 0;
   EngineKind engine = EngineKind::kNone;

@@ -93,6 +93,9 @@ struct FixSample {
   double lat_deg = kNaN, lon_deg = kNaN, alt_m = kNaN;
   double speed_mps = kNaN, accuracy_m = kNaN, bearing_deg = kNaN;
   double speed_accuracy_mps = kNaN, bearing_accuracy_deg = kNaN, vertical_accuracy_m = kNaN;
+  /// Android's accuracy is the radius of 68 % confidence: for a circular Gaussian that radius is
+  /// 1.51 per-axis sigmas (sqrt(-2 ln 0.32)), so sigma = accuracy_m / kAccuracyRadiusPerSigma.
+  static constexpr double kAccuracyRadiusPerSigma = 1.51;
 };
 
 /// GnssNavigationMessage (GnssLogger `Nav`): raw navigation data bits of one satellite.

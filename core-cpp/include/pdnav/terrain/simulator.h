@@ -104,14 +104,6 @@ struct WalkEvaluation {
 WalkEvaluation evaluate_walk(const SimulatedWalk& walk, std::shared_ptr<const Dem> dem,
                              const TerrainOptions& options, std::uint64_t seed);
 
-/// The 2-D "1-sigma" ellipse holds the probability of +-1 sigma in 1-D, 68.27 %:
-/// Mahalanobis^2 <= -2 ln(1 - 0.682689) = 2.2957 (ErrorEllipse::scale_for_probability(0.6827)^2).
-inline constexpr double kOneSigmaM2 = 2.295748928898636;
-
-/// Squared Mahalanobis distance d' cov^-1 d of a 2-D offset (inf when cov is not positive definite);
-/// <= 1 means inside the 1-sigma ellipse.
-double mahalanobis2(const Eigen::Matrix2d& cov, const Eigen::Vector2d& d);
-
 /// Seed of walk k of an evaluation with base seed s (SplitMix64 of s and k).
 std::uint64_t walk_seed(std::uint64_t base_seed, std::uint64_t k);
 
