@@ -38,6 +38,7 @@ PdrOptions auto_mount(bool vehicle_class) {
 struct Counted {
   std::size_t steps = 0;
   std::int64_t refused_vehicle = 0;
+  double kinematic_max_mps2 = 0.0;
   MotionState final_state = MotionState::kStanding;
 };
 
@@ -49,7 +50,8 @@ Counted count(const PdrOptions& o, const RealWalk& w) {
     p.feed(s);
   }
   p.finish();
-  return {static_cast<std::size_t>(p.step_count()), p.counters().steps_discarded_by_vehicle, p.motion_state()};
+  return {static_cast<std::size_t>(p.step_count()), p.counters().steps_discarded_by_vehicle,
+          p.counters().vehicle_kinematic_max_mps2, p.motion_state()};
 }
 
 RideSpec ride_spec(std::uint64_t seed) {
@@ -76,8 +78,9 @@ TEST(PdrVehicle, SynthesisedRidesAreClassedVehicleAndCountNoSteps) {
     EXPECT_LT(st.seat_vertical_rms_mps2, 1.5);
     const Counted on = count(auto_mount(true), ride);
     const Counted off = count(auto_mount(false), ride);
-    std::printf("  steps with the vehicle class %zu (refused %lld, state %s), without %zu\n", on.steps,
-                static_cast<long long>(on.refused_vehicle), to_string(on.final_state), off.steps);
+    std::printf("  steps with the vehicle class %zu (refused %lld, state %s, kinematic max %.2f m/s^2), without %zu\n",
+                on.steps, static_cast<long long>(on.refused_vehicle), to_string(on.final_state), on.kinematic_max_mps2,
+                off.steps);
     EXPECT_LE(on.steps, 2u) << "seed " << seed;
     EXPECT_EQ(on.final_state, MotionState::kVehicle) << "seed " << seed;
     // the ride is a real challenge: without the class the step detector counts it (more than

@@ -302,6 +302,8 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
   for (const pdr::MotionSpan& v : pdr.vehicle_spans())
     rides.push_back({{"start_s", ns_to_s(v.t_start_ns - t0_ns)}, {"end_s", ns_to_s(v.t_end_ns - t0_ns)}});
   j["vehicle_spans"] = rides;
+  j["vehicle_max_score_s"] = c.vehicle_max_score_s;
+  j["vehicle_kinematic_max_mps2"] = c.vehicle_kinematic_max_mps2;
   j["magnetometer_readings_trusted"] = c.mag_readings_trusted;
   j["magnetometer_readings_disturbed"] = c.mag_readings_disturbed;
   const pdr::MagCalibration& cal = pdr.mag_calibration();

@@ -27,6 +27,7 @@ void MotionClassifier::feed(const AccelSample& s) {
   acc_.emplace_back(s.t_ns, m);
   acc_sum_ += m;
   acc_sq_ += m * m;
+  kinematic_accel(s);
   vehicle_sample(s.t_ns, m, nullptr);
   const TimeNs horizon = s.t_ns - s_to_ns(opt_.window_s);
   while (!acc_.empty() && acc_.front().first <= horizon) {
@@ -45,6 +46,7 @@ void MotionClassifier::feed(const AccelSample& s) {
 void MotionClassifier::feed(const GyroSample& s) {
   if (!s.rate_radps.allFinite() || (last_gyro_ns_ >= 0 && s.t_ns <= last_gyro_ns_)) return;
   last_gyro_ns_ = s.t_ns;
+  kinematic_gyro(s);
   vehicle_sample(s.t_ns, kNaN, &s.rate_radps);
   gyro_.emplace_back(s.t_ns, s.rate_radps);
   gyro_outer_ += s.rate_radps * s.rate_radps.transpose();
@@ -237,16 +239,74 @@ void MotionClassifier::vehicle_evaluate(TimeNs t_ns) {
   }
   const bool evidence = corr < opt_.aperiodic_max && min_sigma >= opt_.vehicle_min_sigma_mps2 &&
                         max_sigma <= opt_.vehicle_max_sigma_mps2 && rate_rms <= opt_.vehicle_max_rate_radps;
+  // kinematic evidence: a sustained horizontal acceleration while the phone turns slowly
+  if (opt_.kinematic_min_mps2 > 0.0 && gyro_live && rate_rms <= opt_.vehicle_max_rate_radps && !kin_h_.empty() &&
+      ns_to_s(kin_h_.back().first - kin_h_.front().first) >= 0.9 * opt_.kinematic_window_s) {
+    const double a_h = kin_sum_.norm() / static_cast<double>(kin_h_.size());
+    kinematic_max_mps2_ = std::max(kinematic_max_mps2_, a_h);
+    if (a_h >= opt_.kinematic_min_mps2) kinematic_last_ns_ = t_ns;
+  }
   if (evidence) {
     if (vehicle_score_s_ <= 0.0) evidence_start_ns_ = t_ns - s_to_ns(opt_.vehicle_window_s);
     vehicle_score_s_ += opt_.vehicle_eval_s;
   } else {
     vehicle_score_s_ = std::max(0.0, vehicle_score_s_ - opt_.vehicle_decay * opt_.vehicle_eval_s);
   }
-  if (vehicle_score_s_ >= opt_.vehicle_enter_s) {
+  // with a gyroscope, no vehicle without a speed change or turn no walker makes (the score
+  // waits at the threshold for one)
+  const bool kinematic_ok = opt_.kinematic_min_mps2 <= 0.0 || kin_gyro_ns_ < 0 || kinematic_recent(t_ns);
+  if (vehicle_score_s_ >= opt_.vehicle_enter_s && !kinematic_ok) vehicle_score_s_ = opt_.vehicle_enter_s;
+  vehicle_max_score_s_ = std::max(vehicle_max_score_s_, vehicle_score_s_);
+  if (vehicle_score_s_ >= opt_.vehicle_enter_s && kinematic_ok) {
     vehicle_ = true;
     vehicle_spans_.push_back(MotionSpan{evidence_start_ns_, t_ns, MotionState::kVehicle});
     if (vehicle_spans_.size() > 256) vehicle_spans_.pop_front();
+  }
+}
+
+bool MotionClassifier::kinematic_recent(TimeNs t_ns) const {
+  return kinematic_last_ns_ >= 0 && t_ns - kinematic_last_ns_ <= s_to_ns(opt_.kinematic_memory_s);
+}
+
+void MotionClassifier::kinematic_gyro(const GyroSample& s) {
+  // a world-fixed vector seen from the turning phone: d up / dt = -omega x up
+  if (kin_have_up_ && kin_gyro_ns_ >= 0) {
+    const double dt = ns_to_s(s.t_ns - kin_gyro_ns_);
+    if (dt > 0.0 && dt <= opt_.gyro_timeout_s) kin_up_ = (kin_up_ - dt * s.rate_radps.cross(kin_up_)).normalized();
+  }
+  kin_gyro_ns_ = s.t_ns;
+}
+
+void MotionClassifier::kinematic_accel(const AccelSample& s) {
+  if (opt_.kinematic_min_mps2 <= 0.0) return;
+  const double m = s.acc_mps2.norm();
+  if (!(m > 1.0)) return;  // free fall or a broken sample: no gravity direction
+  const Eigen::Vector3d dir = s.acc_mps2 / m;
+  const double dt = kin_acc_ns_ >= 0 ? ns_to_s(s.t_ns - kin_acc_ns_) : -1.0;
+  kin_acc_ns_ = s.t_ns;
+  // first sample, a gap, or no live gyroscope (the phone's turns can not be followed): gravity
+  // restarts from the specific force and the window with it
+  const bool gyro_live = kin_gyro_ns_ >= 0 && ns_to_s(s.t_ns - kin_gyro_ns_) <= opt_.gyro_timeout_s;
+  if (!kin_have_up_ || dt < 0.0 || dt > opt_.gyro_timeout_s || !gyro_live) {
+    kin_up_ = dir;
+    kin_have_up_ = true;
+    kin_h_.clear();
+    kin_sum_.setZero();
+    return;
+  }
+  // pulled toward the specific force with tau (the complementary filter of the tilt; gyro-propagated)
+  kin_up_ = (kin_up_ + std::min(1.0, dt / opt_.kinematic_tilt_tau_s) * (dir - kin_up_)).normalized();
+  const Eigen::Vector3d h = s.acc_mps2 - s.acc_mps2.dot(kin_up_) * kin_up_;
+  kin_h_.emplace_back(s.t_ns, h);
+  kin_sum_ += h;
+  const TimeNs horizon = s.t_ns - s_to_ns(opt_.kinematic_window_s);
+  while (!kin_h_.empty() && kin_h_.front().first <= horizon) {
+    kin_sum_ -= kin_h_.front().second;
+    kin_h_.pop_front();
+  }
+  if (kin_h_.size() % 1024 == 0) {
+    kin_sum_.setZero();
+    for (const auto& [t, v] : kin_h_) kin_sum_ += v;
   }
 }
 

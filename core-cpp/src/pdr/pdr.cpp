@@ -565,6 +565,8 @@ PdrCounters Pdr::counters() const {
   c.gyro = tracker_.gyro_counters();
   c.steps_discarded_by_bout_gate = gate_.discarded();
   c.steps_added_at_stride_midpoints = detector_.stride_steps_added();
+  c.vehicle_max_score_s = classifier_.vehicle_max_score_s();
+  c.vehicle_kinematic_max_mps2 = classifier_.kinematic_max_mps2();
   c.mag_readings_trusted = fusion_.accepted();
   c.mag_readings_disturbed = fusion_.disturbed();
   return c;

@@ -90,6 +90,11 @@ struct PdrCounters {
   std::int64_t steps_discarded_by_bout_gate = 0;
   std::int64_t steps_discarded_by_motion = 0;  // candidates while the phone was handled/waved
   std::int64_t steps_discarded_by_vehicle = 0;  // steps inside a vehicle span (car, bus, train)
+  /// The vehicle evidence at its highest outside a vehicle span: the leaky score (s, entered at
+  /// MotionClassifierOptions::vehicle_enter_s) and the mean horizontal acceleration while the
+  /// phone turned slowly (m/s^2, kinematic_min_mps2; 0 without a gyroscope).
+  double vehicle_max_score_s = 0.0;
+  double vehicle_kinematic_max_mps2 = 0.0;
   std::int64_t steps_added_at_stride_midpoints = 0;  // swinging hand / running strides split (stage 4)
   /// Steps emitted before the placement bout they belong to had begun (its walking direction
   /// was waited for max_direction_wait_s in vain): they carry the previous bout's direction.
