@@ -311,3 +311,20 @@ TEST(PdrVehicle, AWalkerHoldingThePhoneUpIsNotInAVehicle) {
   EXPECT_FALSE(without->vehicle_spans().empty());
   EXPECT_LT(without->step_count(), pdr->step_count());
 }
+
+TEST(PdrVehicle, NoMotionCaptureRecordingIsARide) {
+  // every carry, running included, with and without magnets: no vehicle span, no step refused
+  // as riding (the ILC, Oxford and ETH walks: vehicle_test.cpp)
+  const char* names[] = {"Guillaume_Nexus5_Dist_AR", "Guillaume_Nexus5_Dist_BackPocket", "Guillaume_Nexus5_Dist_FrontPocket",
+                         "Guillaume_Nexus5_Dist_Phoning", "Guillaume_Nexus5_Dist_Swinging", "Guillaume_Nexus5_Dist_Texting",
+                         "Guillaume_Nexus5_NoDist_AR", "Guillaume_Nexus5_NoDist_BackPocket", "Guillaume_Nexus5_NoDist_FrontPocket",
+                         "Guillaume_Nexus5_NoDist_Phoning", "Guillaume_Nexus5_NoDist_RunningHand",
+                         "Guillaume_Nexus5_NoDist_RunningPocket", "Guillaume_Nexus5_NoDist_Swinging", "Guillaume_Nexus5_NoDist_Texting"};
+  for (const char* name : names) {
+    const auto pdr = replayed(name);
+    const PdrCounters c = pdr->counters();
+    std::printf("%-40s score max %5.2f s, kinematic max %.2f m/s^2\n", name, c.vehicle_max_score_s, c.vehicle_kinematic_max_mps2);
+    EXPECT_TRUE(pdr->vehicle_spans().empty()) << name;
+    EXPECT_EQ(c.steps_discarded_by_vehicle, 0) << name;
+  }
+}
