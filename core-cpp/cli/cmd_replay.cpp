@@ -3,6 +3,7 @@
 // carries a reference (Truth lines, else the phone's GPS Fix lines), error statistics.
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -169,6 +170,24 @@ int run_replay(const ReplayArgs& a) {
   for (const auto& [type, n] : reader.stats().samples_by_type) std::cout << "  " << type << ": " << n << "\n";
   for (const auto& [why, n] : reader.stats().skipped_by_reason) std::cout << "  skipped " << n << ": " << why << "\n";
   print_not_used(std::cout, reader.stats());
+  {
+    // the PDR in one line: what it counted and refused, and whether it thought it rode a vehicle
+    const nlohmann::json& p = summary["pdr"];
+    const auto f1 = [](double v) {
+      char b[32];
+      std::snprintf(b, sizeof b, "%.1f", v);
+      return std::string(b);
+    };
+    std::cout << "pdr:      " << p["steps"].get<std::int64_t>() << " steps, " << f1(p["distance_m"].get<double>()) << " m ("
+              << p["sensor_set"].get<std::string>() << ", heading: " << p["heading_reference"].get<std::string>()
+              << "); refused: handling " << p["steps_refused_handling"].get<std::int64_t>() << ", vehicle "
+              << p["steps_refused_vehicle"].get<std::int64_t>() << "; vehicle spans: ";
+    if (p["vehicle_spans"].empty()) std::cout << "none";
+    for (std::size_t i = 0; i < p["vehicle_spans"].size(); ++i)
+      std::cout << (i ? ", " : "") << f1(p["vehicle_spans"][i]["start_s"].get<double>()) << "-"
+                << f1(p["vehicle_spans"][i]["end_s"].get<double>()) << " s";
+    std::cout << "; longest step delay " << f1(p["max_step_delay_s"].get<double>()) << " s\n";
+  }
   std::cout << "epochs:   " << rec.epochs().size() << "\n";
   std::cout << "mode changes: " << nav.output(0).mode_change_count << " (summary.json fusion.mode_changes)\n";
   for (const auto& [eng, n] : rec.epochs_by_engine()) std::cout << "  " << eng << ": " << n << "\n";
