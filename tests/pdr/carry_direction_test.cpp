@@ -290,7 +290,8 @@ TEST(PdrVehicle, AWalkerHoldingThePhoneUpIsNotInAVehicle) {
   // the gait exit never comes, so every step was refused. A vehicle must also change speed or
   // turn as no walker does (MotionClassifierOptions::kinematic_min_mps2, Hemminki et al. 2013);
   // here the sustained horizontal acceleration peaks at 0.73 m/s^2 (accelerometer bias and
-  // scale leaking as the phone turns), the synthesised rides reach 1.0-1.8 (vehicle_test.cpp).
+  // scale leaking as the phone turns), the synthesised rides reach 1.0-1.8 (vehicle_test.cpp;
+  // printed there as the peak before each is classed, 0.9-1.0).
   const char* name = "Guillaume_Nexus5_NoDist_AR";
   const auto pdr = replayed(name);
   const PdrCounters c = pdr->counters();

@@ -45,8 +45,8 @@ void MotionClassifier::feed(const AccelSample& s) {
 
 void MotionClassifier::feed(const GyroSample& s) {
   if (!s.rate_radps.allFinite() || (last_gyro_ns_ >= 0 && s.t_ns <= last_gyro_ns_)) return;
+  kinematic_gyro(s);  // (reads the previous sample's time)
   last_gyro_ns_ = s.t_ns;
-  kinematic_gyro(s);
   vehicle_sample(s.t_ns, kNaN, &s.rate_radps);
   gyro_.emplace_back(s.t_ns, s.rate_radps);
   gyro_outer_ += s.rate_radps * s.rate_radps.transpose();
@@ -254,7 +254,7 @@ void MotionClassifier::vehicle_evaluate(TimeNs t_ns) {
   }
   // with a gyroscope, no vehicle without a speed change or turn no walker makes (the score
   // waits at the threshold for one)
-  const bool kinematic_ok = opt_.kinematic_min_mps2 <= 0.0 || kin_gyro_ns_ < 0 || kinematic_recent(t_ns);
+  const bool kinematic_ok = opt_.kinematic_min_mps2 <= 0.0 || last_gyro_ns_ < 0 || kinematic_recent(t_ns);
   if (vehicle_score_s_ >= opt_.vehicle_enter_s && !kinematic_ok) vehicle_score_s_ = opt_.vehicle_enter_s;
   vehicle_max_score_s_ = std::max(vehicle_max_score_s_, vehicle_score_s_);
   if (vehicle_score_s_ >= opt_.vehicle_enter_s && kinematic_ok) {
@@ -270,11 +270,10 @@ bool MotionClassifier::kinematic_recent(TimeNs t_ns) const {
 
 void MotionClassifier::kinematic_gyro(const GyroSample& s) {
   // a world-fixed vector seen from the turning phone: d up / dt = -omega x up
-  if (kin_have_up_ && kin_gyro_ns_ >= 0) {
-    const double dt = ns_to_s(s.t_ns - kin_gyro_ns_);
+  if (kin_have_up_ && last_gyro_ns_ >= 0) {
+    const double dt = ns_to_s(s.t_ns - last_gyro_ns_);
     if (dt > 0.0 && dt <= opt_.gyro_timeout_s) kin_up_ = (kin_up_ - dt * s.rate_radps.cross(kin_up_)).normalized();
   }
-  kin_gyro_ns_ = s.t_ns;
 }
 
 void MotionClassifier::kinematic_accel(const AccelSample& s) {
@@ -286,7 +285,7 @@ void MotionClassifier::kinematic_accel(const AccelSample& s) {
   kin_acc_ns_ = s.t_ns;
   // first sample, a gap, or no live gyroscope (the phone's turns can not be followed): gravity
   // restarts from the specific force and the window with it
-  const bool gyro_live = kin_gyro_ns_ >= 0 && ns_to_s(s.t_ns - kin_gyro_ns_) <= opt_.gyro_timeout_s;
+  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(s.t_ns - last_gyro_ns_) <= opt_.gyro_timeout_s;
   if (!kin_have_up_ || dt < 0.0 || dt > opt_.gyro_timeout_s || !gyro_live) {
     kin_up_ = dir;
     kin_have_up_ = true;

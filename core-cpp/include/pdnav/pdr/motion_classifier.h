@@ -115,7 +115,7 @@ struct MotionClassifierOptions {
   // 0.6 m/s^2 under that rate. With a gyroscope the vehicle is entered only when such evidence
   // lies within kinematic_memory_s (a ride's stops and turns recur within minutes); without one
   // (accelerometer-only data) the score alone decides, as before. Measured (docs/pdr.md): the
-  // synthesised rides 1.01-1.76 m/s^2, the shared real walks <= 0.73 but one ILC walk at 1.01
+  // synthesised rides reach 1.01-1.76 m/s^2, the shared real walks <= 0.73 but one ILC walk at 1.01
   // (accelerometer bias and scale leak into the horizontal as a phone is turned). 0 = off.
   double kinematic_min_mps2 = 0.8;
   double kinematic_window_s = 3.0;
@@ -144,9 +144,9 @@ class MotionClassifier {
   /// Latest vehicle-window features: max gait autocorrelation, min / max 1 s sigma |a|.
   double gait_autocorrelation() const { return gait_corr_; }
   double vehicle_score_s() const { return vehicle_score_s_; }
-  /// Largest mean horizontal acceleration over kinematic_window_s seen so far while the phone
-  /// turned slowly (m/s^2; MotionClassifierOptions::kinematic_min_mps2), and the last time it
-  /// reached the threshold (-1: never).
+  /// Largest mean horizontal acceleration over kinematic_window_s seen so far outside a vehicle
+  /// span while the phone turned slowly (m/s^2; MotionClassifierOptions::kinematic_min_mps2), and
+  /// the last time it reached the threshold (-1: never).
   double kinematic_max_mps2() const { return kinematic_max_mps2_; }
   /// Highest vehicle score reached outside a vehicle span (s).
   double vehicle_max_score_s() const { return vehicle_max_score_s_; }
@@ -217,7 +217,7 @@ class MotionClassifier {
   // kinematic evidence: gyro-propagated gravity (phone axes) and the horizontal specific force
   Eigen::Vector3d kin_up_ = Eigen::Vector3d::UnitZ();
   bool kin_have_up_ = false;
-  TimeNs kin_acc_ns_ = -1, kin_gyro_ns_ = -1;
+  TimeNs kin_acc_ns_ = -1;  // previous accelerometer sample the filter took (the gyro's: last_gyro_ns_)
   std::deque<std::pair<TimeNs, Eigen::Vector3d>> kin_h_;
   Eigen::Vector3d kin_sum_ = Eigen::Vector3d::Zero();
   TimeNs kinematic_last_ns_ = -1;
