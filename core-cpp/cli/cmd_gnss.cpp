@@ -247,9 +247,9 @@ void print_summary(const std::vector<gnss::EpochSolution>& sols, const gnss::Gns
 }
 
 void print_accuracy(const gnss::StaticAccuracy& a) {
-  std::printf("%-22s %8s %8s %8s %8s\n", "vs truth", "p50_h_m", "p95_h_m", "rms_h_m", "rms_v_m");
-  std::printf("%-22s %8.2f %8.2f %8.2f %8.2f   (%d epochs)\n", "SPP", a.spp_p50_h_m, a.spp_p95_h_m, a.spp_rms_h_m, a.spp_rms_v_m, a.spp_epochs);
-  std::printf("%-22s %8.2f %8.2f %8.2f %8.2f   (%d epochs)\n", "KF", a.kf_p50_h_m, a.kf_p95_h_m, a.kf_rms_h_m, a.kf_rms_v_m, a.kf_epochs);
+  std::printf("%-22s %8s %8s %8s %8s %8s\n", "vs truth", "p50_h_m", "p95_h_m", "rms_h_m", "rms_v_m", "cov68");
+  std::printf("%-22s %8.2f %8.2f %8.2f %8.2f %8s   (%d epochs)\n", "SPP", a.spp_p50_h_m, a.spp_p95_h_m, a.spp_rms_h_m, a.spp_rms_v_m, "-", a.spp_epochs);
+  std::printf("%-22s %8.2f %8.2f %8.2f %8.2f %8.3f   (%d epochs)\n", "KF", a.kf_p50_h_m, a.kf_p95_h_m, a.kf_rms_h_m, a.kf_rms_v_m, a.kf_coverage68, a.kf_epochs);
   std::printf("1 s displacement RMS (static truth 0), cm: TDCP e/n/u %.2f %.2f %.2f (%d), Doppler e/n/u %.2f %.2f %.2f (%d)\n",
               a.tdcp_rms_enu_m.x() * 100, a.tdcp_rms_enu_m.y() * 100, a.tdcp_rms_enu_m.z() * 100, a.tdcp_epochs,
               a.doppler_rms_enu_m.x() * 100, a.doppler_rms_enu_m.y() * 100, a.doppler_rms_enu_m.z() * 100, a.doppler_epochs);
@@ -265,7 +265,7 @@ void write_residuals(const std::string& path, const std::vector<gnss::EpochSolut
   const gnss::TruthTrack track = have_static ? gnss::TruthTrack() : gnss::read_truth_csv_file(a.truth_csv);
   std::ofstream f(path);
   if (!f) throw std::runtime_error(path + ": cannot write");
-  f << "gps_ns,sys,svid,band,cn0_dbhz,el_deg,raw_m,smoothed_m,group_size,iono_free\n";
+  f << "gps_ns,sys,svid,band,cn0_dbhz,el_deg,raw_m,smoothed_m,group_size,iono_free,az_deg\n";
   std::int64_t rows = 0, epochs = 0;
   for (const gnss::EpochSolution& s : sols) {
     if (s.code_obs.empty()) continue;
@@ -288,10 +288,10 @@ void write_residuals(const std::string& path, const std::vector<gnss::EpochSolut
     for (const auto& r : r_raw) {
       const auto it = smoothed.find(r.sat);
       char line[256];
-      std::snprintf(line, sizeof line, "%lld,%c,%d,%s,%.2f,%.3f,%.4f,%.4f,%d,%d\n", static_cast<long long>(s.gps_ns),
+      std::snprintf(line, sizeof line, "%lld,%c,%d,%s,%.2f,%.3f,%.4f,%.4f,%d,%d,%.3f\n", static_cast<long long>(s.gps_ns),
                     gnss::rinex_letter(r.sat.sys), r.sat.prn, gnss::to_string(gnss::signal_band(r.carrier_hz)),
                     r.cn0_dbhz, r.el_rad * 180.0 / kPi, r.residual_m, it == smoothed.end() ? kNaN : it->second,
-                    r.group_size, iono_free[r.sat] ? 1 : 0);
+                    r.group_size, iono_free[r.sat] ? 1 : 0, r.az_rad * 180.0 / kPi);
       f << line;
       ++rows;
     }
@@ -372,9 +372,10 @@ void run_gnss(const GnssArgs& a) {
                 t.kf.coverage68);
   }
   const double nan = kNaN;
-  std::printf("spp_p50_h_m: %.2f spp_p95_h_m: %.2f kf_rms_h_m: %.2f tdcp_rms_cm: %.2f\n",
+  std::printf("spp_p50_h_m: %.2f spp_p95_h_m: %.2f kf_rms_h_m: %.2f tdcp_rms_cm: %.2f kf_cov68: %.3f\n",
               have_truth ? acc.spp_p50_h_m : nan, have_truth ? acc.spp_p95_h_m : nan,
-              have_truth ? acc.kf_rms_h_m : nan, acc.tdcp_rms_max_axis_m() * 100.0);
+              have_truth ? acc.kf_rms_h_m : nan, acc.tdcp_rms_max_axis_m() * 100.0,
+              have_truth ? acc.kf_coverage68 : nan);
 }
 
 }  // namespace

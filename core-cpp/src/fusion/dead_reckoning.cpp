@@ -12,6 +12,7 @@ void DeadReckoning::initialize(const geo::Geodetic& start, double sigma_m, TimeN
   p_(0, 0) = p_(1, 1) = sigma_m * sigma_m;
   p_(2, 2) = opt_.heading_bias_sigma_rad * opt_.heading_bias_sigma_rad;
   p_(3, 3) = opt_.length_scale_sigma * opt_.length_scale_sigma;
+  p_(4, 4) = p_(5, 5) = opt_.compass_deviation_sigma_rad * opt_.compass_deviation_sigma_rad;
   t_ns_ = t_ns;
   initialized_ = true;
   have_steps_ = false;
@@ -53,14 +54,22 @@ void DeadReckoning::feed(const PdrStep& step) {
   // FOGM bias: b' = phi b + w, phi = exp(-dt/tau), var(w) = sigma^2 (1 - phi^2)
   const double phi = std::exp(-dt / opt_.heading_bias_tau_s);
   x_(2) *= phi;
-  Eigen::Matrix4d f = Eigen::Matrix4d::Identity();
+  Mat6 f = Mat6::Identity();
   f(0, 2) = l * c;
   f(1, 2) = -l * s;
   f(2, 2) = phi;
   f(0, 3) = l0 * s;  // the scale error moves every step along its own direction
   f(1, 3) = l0 * c;
+  if (absolute) {
+    // heading error B sin(psi) + C cos(psi) at this step's heading (B, C stay 0: never observed here)
+    const double sp = std::sin(step.heading_rad), cp = std::cos(step.heading_rad);
+    f(0, 4) = l * c * sp;
+    f(1, 4) = -l * s * sp;
+    f(0, 5) = l * c * cp;
+    f(1, 5) = -l * s * cp;
+  }
   const double sl = std::isfinite(step.length_sigma_m) && step.length_sigma_m > 0 ? step.length_sigma_m : opt_.length_sigma_m;
-  Eigen::Matrix4d q = Eigen::Matrix4d::Zero();
+  Mat6 q = Mat6::Zero();
   q.topLeftCorner<2, 2>() = sl * sl * (Eigen::Vector2d(s, c) * Eigen::Vector2d(s, c).transpose());
   q(2, 2) = bias_sigma * bias_sigma * (1.0 - phi * phi);
   q(3, 3) = opt_.length_scale_rw_1ps * dt;

@@ -43,6 +43,7 @@ StaticAccuracy evaluate_static(const std::vector<EpochSolution>& sols, const geo
   const geo::LocalFrame frame(truth);
   std::vector<double> spp_h, spp_v, kf_h, kf_v;
   std::vector<Eigen::Vector3d> tdcp, dopp;
+  int inside = 0;
   for (const EpochSolution& s : sols) {
     if (s.spp_ok) {
       const geo::Enu e = frame.to_enu(s.spp);
@@ -53,6 +54,9 @@ StaticAccuracy evaluate_static(const std::vector<EpochSolution>& sols, const geo
       const geo::Enu e = frame.to_enu(s.kf);
       kf_h.push_back(std::hypot(e.e_m(), e.n_m()));
       kf_v.push_back(e.u_m());
+      const Eigen::Matrix2d c = s.kf_cov_enu.topLeftCorner<2, 2>();
+      const Eigen::Vector2d d(e.e_m(), e.n_m());
+      if (c.determinant() > 0) inside += d.dot(c.inverse() * d) <= 2.279;
     }
     if (!s.disp_source.empty() && std::fabs(s.disp_dt_s - 1.0) <= 0.1) {
       (s.disp_source == "tdcp" ? tdcp : dopp).push_back(s.tdcp_disp_m);
@@ -71,6 +75,7 @@ StaticAccuracy evaluate_static(const std::vector<EpochSolution>& sols, const geo
   a.kf_p50_h_m = percentile(kf_h, 50.0);
   a.kf_p95_h_m = percentile(kf_h, 95.0);
   a.kf_rms_v_m = rms(kf_v);
+  a.kf_coverage68 = kf_h.empty() ? kNaN : static_cast<double>(inside) / static_cast<double>(kf_h.size());
   a.tdcp_rms_enu_m = rms_axes(tdcp);
   a.doppler_rms_enu_m = rms_axes(dopp);
   return a;

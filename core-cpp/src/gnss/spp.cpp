@@ -68,6 +68,7 @@ struct Row {
   Eigen::Vector3d los = Eigen::Vector3d::Zero();  // unit vector receiver -> satellite
   double var_m2 = 1.0;
   double el_rad = kPi / 2;
+  double az_rad = 0.0;
   bool masked = false;
 };
 
@@ -103,6 +104,7 @@ Row model_row(const SppObservation& o, const Eigen::VectorXd& x, const Layout& l
     const geo::Ecef rx_ecef(rx);
     const AzEl ae = azimuth_elevation(rx_ecef, geo::Ecef(sat));
     r.el_rad = ae.el_rad;
+    r.az_rad = ae.az_rad;
     r.masked = ae.el_rad < deg_to_rad(opt.elevation_mask_deg);
     const geo::Geodetic g = geo::to_geodetic(rx_ecef);
     if (opt.ionosphere && klob != nullptr && ae.el_rad > 0.0 && !o.iono_free) {
@@ -372,7 +374,7 @@ std::vector<TruthResidual> residuals_at_truth(const std::vector<SppObservation>&
     const Row r = model_row(*o, x, l, gps_tow_s, klob, opt);
     if (r.masked || !std::isfinite(r.residual_m)) continue;
     ++count[clock_key(*o)];
-    out.push_back(TruthResidual{o->sat, o->carrier_hz, o->cn0_dbhz, r.el_rad, r.residual_m, 0});
+    out.push_back(TruthResidual{o->sat, o->carrier_hz, o->cn0_dbhz, r.el_rad, r.az_rad, r.residual_m, 0});
     los.push_back(r.los);
     keys.push_back(clock_key(*o));
   }

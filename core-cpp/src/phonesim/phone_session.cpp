@@ -180,6 +180,19 @@ struct Channel {
   double nlos_m = 0.0, nlos_until_s = -1.0;
 };
 
+/// Slant delay (m) of a horizontal gradient g (east, north; m of vertical delay per km) of the
+/// vertical ionospheric delay, evaluated at the pierce point of a satellite at (az, el): the
+/// Earth-central angle to a 350 km shell and the obliquity factor of the broadcast model
+/// (IS-GPS-200 20.3.3.5.2.5: psi = 0.0137 / (E + 0.11) - 0.022, F = 1 + 16 (0.53 - E)^3, E in
+/// semicircles).
+double iono_gradient_slant_m(const Eigen::Vector2d& g_m_per_km, double az_rad, double el_rad) {
+  const double e_sc = el_rad / kPi;
+  const double psi_sc = std::max(0.0, 0.0137 / (e_sc + 0.11) - 0.022);
+  const double d_km = psi_sc * kPi * 6371.0;
+  const double obliquity = 1.0 + 16.0 * std::pow(0.53 - e_sc, 3);
+  return obliquity * d_km * (g_m_per_km.x() * std::sin(az_rad) + g_m_per_km.y() * std::cos(az_rad));
+}
+
 }  // namespace
 
 std::int64_t session_unix_ms(const PhoneSession& s, TimeNs t_ns) {
@@ -439,6 +452,11 @@ PhoneSession simulate_session(const terrain::Dem& dem, const route::WalkGraph& g
     ch[s] = c;
   }
   const double iono_scale = std::max(0.2, 1.0 + gauss(rng, go.iono_scale_sd));
+  // Its own stream of the seed: the gradient does not reshuffle the session's other draws.
+  Rng iono_rng(seed ^ 0x9e3779b97f4a7c15ULL);
+  const Eigen::Vector2d iono_gradient_m_per_km(gauss(iono_rng, go.iono_gradient_sd_m_per_km),
+                                               gauss(iono_rng, go.iono_gradient_sd_m_per_km));
+  ses.stats.iono_gradient_m_per_km = iono_gradient_m_per_km;
   const double tropo_scale = 1.0 + gauss(rng, go.tropo_scale_sd);
   const double drift0 = std::clamp(gauss(rng, go.clock_drift_sd_nsps), -200.0, 200.0);
   double drift_nsps = drift0, clock_ns = uniform(rng, -500.0, 500.0);
@@ -545,7 +563,8 @@ PhoneSession simulate_session(const terrain::Dem& dem, const route::WalkGraph& g
       }
       // Pseudorange errors.
       const double iono = (klob ? kSpeedOfLight_mps * gnss::klobuchar_delay_s(*klob, g_rx, ae.az_rad, ae.el_rad, tow_s)
-                                : 5.0 / std::sqrt(std::max(0.05, std::sin(ae.el_rad)))) * iono_scale;
+                                : 5.0 / std::sqrt(std::max(0.05, std::sin(ae.el_rad)))) * iono_scale +
+                         iono_gradient_slant_m(iono_gradient_m_per_km, ae.az_rad, ae.el_rad);
       const double tropo = gnss::saastamoinen_delay_m(g_rx, ae.el_rad) * tropo_scale;
       const double white_sd = go.code_sigma_at_40_m * std::pow(10.0, -(cn0 - 40.0) / 20.0);
       const double mp_amp = (degr || forest ? go.multipath_degraded_m : go.multipath_open_m) * std::exp(-ae.el_rad / (25.0 * kDegToRad));

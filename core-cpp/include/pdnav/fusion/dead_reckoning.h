@@ -36,6 +36,14 @@ struct DeadReckoningOptions {
   // along-track error at all). 0/NaN sigma = unknown: the fixed model above.
   bool use_step_heading_sigma = true;
   double absolute_heading_max_sigma_rad = 60.0 * kDegToRad;
+  // A magnetic heading's error also depends on the heading itself: the one-cycle deviation
+  // B sin(psi) + C cos(psi) of a compass (Bowditch, American Practical Navigator, Ch. 6; the
+  // hard-iron field left after calibration turns with the phone). Unlike the bias it does not
+  // average out around a loop: a walker circling drifts by ~B L / 2 after L metres. B and C are
+  // random constants of this sigma, on absolute-heading steps only (measured per walk as the
+  // heading error's sin/cos fit against the truth: TYREX 2-5 deg beyond the fit's noise, ETH
+  // after the hard-iron calibration 4.4 / 2.4 deg). 0 = off.
+  double compass_deviation_sigma_rad = 5.0 * kDegToRad;
 };
 
 class DeadReckoning {
@@ -55,8 +63,11 @@ class DeadReckoning {
   DeadReckoningOptions opt_;
   bool initialized_ = false;
   geo::LocalFrame frame_;
-  Eigen::Vector4d x_ = Eigen::Vector4d::Zero();  // e, n, heading bias, step-length scale error
-  Eigen::Matrix4d p_ = Eigen::Matrix4d::Zero();
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  // e, n, heading bias, step-length scale error, compass deviation B (sin) and C (cos)
+  Vec6 x_ = Vec6::Zero();
+  Mat6 p_ = Mat6::Zero();
   TimeNs t_ns_ = 0;
   bool have_steps_ = false;
   bool absolute_heading_seen_ = false;

@@ -19,6 +19,9 @@ struct StaticAccuracy {
   int spp_epochs = 0, kf_epochs = 0, tdcp_epochs = 0, doppler_epochs = 0;
   double spp_p50_h_m = kNaN, spp_p95_h_m = kNaN, spp_rms_h_m = kNaN, spp_rms_v_m = kNaN;
   double kf_rms_h_m = kNaN, kf_p50_h_m = kNaN, kf_p95_h_m = kNaN, kf_rms_v_m = kNaN;
+  /// Fraction of KF epochs whose horizontal error is inside the 2-D 68 % ellipse of the reported
+  /// covariance (Mahalanobis^2 <= 2.279), as TrackStats::coverage68.
+  double kf_coverage68 = kNaN;
   Eigen::Vector3d tdcp_rms_enu_m = Eigen::Vector3d::Constant(kNaN);     // per axis, TDCP epochs
   Eigen::Vector3d doppler_rms_enu_m = Eigen::Vector3d::Constant(kNaN);  // per axis, Doppler fallback epochs
   double tdcp_rms_max_axis_m() const { return tdcp_rms_enu_m.allFinite() ? tdcp_rms_enu_m.maxCoeff() : kNaN; }

@@ -102,6 +102,7 @@ struct TruthResidual {
   double carrier_hz = 0.0;
   double cn0_dbhz = 0.0;
   double el_rad = 0.0;
+  double az_rad = 0.0;      // clockwise from north
   double residual_m = 0.0;  // measured - modelled - receiver clock of its clock group
   int group_size = 0;       // satellites of its clock group that epoch
 };

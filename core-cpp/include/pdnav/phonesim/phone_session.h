@@ -38,6 +38,10 @@ struct GnssWorldOptions {
   double foliage_loss_db = 7.0;         // forest (from the DEM error's forest mask)
   double urban_loss_db = 6.0;           // degraded "urban" segments
   double iono_scale_sd = 0.35;          // true iono = Klobuchar x N(1, sd) (Klobuchar removes ~50 %)
+  // ... plus a horizontal gradient of the vertical delay across the pierce points, N(0, sd) per
+  // axis per session (m per km), which a Klobuchar-shaped error lacks: it biases the horizontal
+  // fix for minutes (0 = off; docs/simulator.md "GNSS").
+  double iono_gradient_sd_m_per_km = 0.5e-3;
   double tropo_scale_sd = 0.05;
   double orbit_clock_sd_m = 0.7;        // broadcast orbit+clock error per satellite (SISRE)
   double clock_drift_sd_nsps = 80.0;    // hardware clock drift d0 ~ N(0, sd), ns/s
@@ -96,6 +100,7 @@ struct SessionStats {
   std::int64_t gnss_epochs = 0, raw_rows = 0, fix_rows = 0, steps = 0;
   std::int64_t masked_by_terrain = 0, nlos_rows = 0, cycle_slips = 0, phone_shifts = 0;
   double forest_fraction = 0.0;         // of the steps
+  Eigen::Vector2d iono_gradient_m_per_km = Eigen::Vector2d::Zero();  // east, north (GnssWorldOptions)
 };
 
 struct PhoneSession {
