@@ -115,29 +115,29 @@ TEST(DeadReckoning, SaysRelativeHeadingOnlyUntilAnAbsoluteHeadingArrives) {
 }
 
 namespace {
-/// Issue 28: a walker whose steps differ from the model by a per-walk scale (the model's step is
-/// 0.75 m; the truth is scale x that, with 5 % white noise per step) walking a wandering path.
-/// The DR is fed the model's steps and the true heading plus a 2 deg Gauss-Markov error (tau
-/// 60 s, the DR's own heading model; an absolute heading of sigma 2 deg, small so that the test
-/// is about the length).
-/// Returns the fraction of epochs (after the first 100 steps) with the truth inside the ellipse
-/// of squared Mahalanobis radius r2.
-double scale_coverage(double walker_scale, std::uint32_t seed, const fusion::DeadReckoningOptions& opt, double r2) {
+/// A walker of `steps` steps of 0.55 s: next(n01, rng, &heading) turns the true heading and returns
+/// the heading the DR is told (the truth's own error added); each step is 0.75 m x
+/// walker_scale x (1 + 5 % white) long, the DR is fed 0.75 m and a 2 deg Gauss-Markov heading
+/// error (tau: the DR's own) on top. Returns the fraction of epochs after the first 100 steps
+/// with the truth inside the DR's ellipse of squared Mahalanobis radius r2.
+template <class Next>
+double dr_coverage(const fusion::DeadReckoningOptions& opt, std::uint32_t seed, int steps, double walker_scale,
+                   double heading0_rad, double r2, Next next) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> n01(0.0, 1.0);
   fusion::DeadReckoning dr(opt);
   dr.initialize(geo::Geodetic::from_deg(47.37, 8.54, 400.0), 1.0, 0);
   Eigen::Vector2d truth = Eigen::Vector2d::Zero();
-  double heading = 0.0, bias = 2.0 * kDegToRad * n01(rng);
+  double heading = heading0_rad, bias = 2.0 * kDegToRad * n01(rng);
   const double phi = std::exp(-0.55 / opt.heading_bias_tau_s);
   int inside = 0, n = 0;
-  for (int i = 0; i < 1500; ++i) {
-    heading += 0.05 * n01(rng);  // a wandering path
+  for (int i = 0; i < steps; ++i) {
+    const double told = next(n01, rng, &heading);
     const double model_m = 0.75;
     const double true_m = walker_scale * model_m * (1.0 + 0.05 * n01(rng));
     truth += true_m * Eigen::Vector2d(std::sin(heading), std::cos(heading));
     bias = phi * bias + std::sqrt(1.0 - phi * phi) * 2.0 * kDegToRad * n01(rng);
-    dr.feed(PdrStep{(i + 1) * 550 * kNsPerMs, model_m, heading + bias, 2.0 * kDegToRad, 0.05 * model_m});
+    dr.feed(PdrStep{(i + 1) * 550 * kNsPerMs, model_m, told + bias, 2.0 * kDegToRad, 0.05 * model_m});
     if (i < 100) continue;
     const Estimate e = dr.estimate();
     const Eigen::Vector2d d = truth - e.en_m;
@@ -145,6 +145,17 @@ double scale_coverage(double walker_scale, std::uint32_t seed, const fusion::Dea
     ++n;
   }
   return static_cast<double>(inside) / n;
+}
+
+/// Issue 28: a walker whose steps differ from the model by a per-walk scale, on a wandering path
+/// (1500 steps), told the true heading (an absolute heading of sigma 2 deg, small so that the
+/// test is about the length).
+double scale_coverage(double walker_scale, std::uint32_t seed, const fusion::DeadReckoningOptions& opt, double r2) {
+  return dr_coverage(opt, seed, 1500, walker_scale, 0.0, r2,
+                     [](std::normal_distribution<double>& n01, std::mt19937& rng, double* heading) {
+    *heading += 0.05 * n01(rng);  // a wandering path
+    return *heading;
+  });
 }
 }  // namespace
 
@@ -182,34 +193,17 @@ TEST(DeadReckoning, StepScaleErrorOfTheWalkerIsCovered) {
 }
 
 namespace {
-/// A walker circling (16 steps a loop, the TYREX motion-capture room) whose magnetic heading has
-/// a one-cycle deviation B sin(psi) + C cos(psi) on top of a 2 deg Gauss-Markov error: the track
-/// drifts by ~B L / 2 though every loop closes. Fraction of epochs after the first 100 steps with
-/// the truth inside the ellipse of squared Mahalanobis radius r2.
+/// A walker circling (16 steps a loop, the TYREX motion-capture room, 600 steps) whose magnetic
+/// heading has a one-cycle deviation B sin(psi) + C cos(psi): the track drifts by ~B L / 2
+/// though every loop closes.
 double deviation_coverage(double b_rad, double c_rad, std::uint32_t seed, const fusion::DeadReckoningOptions& opt,
                           double r2) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> n01(0.0, 1.0);
-  fusion::DeadReckoning dr(opt);
-  dr.initialize(geo::Geodetic::from_deg(45.19, 5.73, 200.0), 0.5, 0);
-  Eigen::Vector2d truth = Eigen::Vector2d::Zero();
-  double heading = 2.0 * kPi * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
-  double bias = 2.0 * kDegToRad * n01(rng);
-  const double phi = std::exp(-0.55 / opt.heading_bias_tau_s);
-  int inside = 0, n = 0;
-  for (int i = 0; i < 600; ++i) {
-    heading = std::fmod(heading + 2.0 * kPi / 16.0, 2.0 * kPi);
-    truth += 0.75 * (1.0 + 0.05 * n01(rng)) * Eigen::Vector2d(std::sin(heading), std::cos(heading));
-    bias = phi * bias + std::sqrt(1.0 - phi * phi) * 2.0 * kDegToRad * n01(rng);
-    const double measured = heading + bias + b_rad * std::sin(heading) + c_rad * std::cos(heading);
-    dr.feed(PdrStep{(i + 1) * 550 * kNsPerMs, 0.75, measured, 2.0 * kDegToRad, 0.05 * 0.75});
-    if (i < 100) continue;
-    const Estimate e = dr.estimate();
-    const Eigen::Vector2d d = truth - e.en_m;
-    inside += d.dot(e.cov_en_m2.inverse() * d) <= r2 ? 1 : 0;
-    ++n;
-  }
-  return static_cast<double>(inside) / n;
+  const double start = 2.0 * kPi * ((seed * 0.6180339887) - std::floor(seed * 0.6180339887));
+  return dr_coverage(opt, seed, 600, 1.0, start, r2,
+                     [b_rad, c_rad](std::normal_distribution<double>&, std::mt19937&, double* heading) {
+    *heading = std::fmod(*heading + 2.0 * kPi / 16.0, 2.0 * kPi);
+    return *heading + b_rad * std::sin(*heading) + c_rad * std::cos(*heading);
+  });
 }
 }  // namespace
 

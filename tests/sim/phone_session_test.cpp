@@ -54,6 +54,14 @@ SessionOptions short_session() {
   return o;
 }
 
+/// short_session() in the open: no degraded segment, no forest.
+SessionOptions open_sky_session() {
+  SessionOptions o = short_session();
+  o.degraded_segments = 0;
+  o.dem_error.forest_fraction = 0.0;
+  return o;
+}
+
 TEST(PhoneSession, StreamHasEveryPhoneLineTypeInTimeOrderAndAnOutage) {
   const terrain::Dem dem = test::synthetic_dem(534, 534, 30.0, test::hills);
   const route::WalkGraph graph = street_grid(5000.0, 200.0);
@@ -91,20 +99,14 @@ TEST(PhoneSession, StreamHasEveryPhoneLineTypeInTimeOrderAndAnOutage) {
   EXPECT_NE(other.truth.front().en_m, s.truth.front().en_m);
 }
 
-// The Raw rows are real Android measurements of the real broadcast sky: the project's GNSS
-// engine (which knows nothing of the simulator) solves them near the truth in open sky.
-TEST(PhoneSession, GnssEngineSolvesTheRawRowsNearTheTruth) {
-  const terrain::Dem dem = test::synthetic_dem(534, 534, 30.0, [](double, double) { return 1200.0; });
-  const route::WalkGraph graph = street_grid(5000.0, 200.0);
-  SessionOptions o = short_session();
-  o.degraded_segments = 0;
-  o.dem_error.forest_fraction = 0.0;
-  const PhoneSession s = simulate_session(dem, graph, gsdc_ephemeris(), o, 11);
+/// Horizontal errors (east, north) of the GNSS engine's SPP fixes against the session's truth
+/// (interpolated between its steps).
+std::vector<Eigen::Vector2d> spp_errors_en(const PhoneSession& s, const terrain::Dem& dem) {
   gnss::GnssEngine engine(gnss::GnssOptions{}, std::make_shared<gnss::EphemerisStore>(gsdc_ephemeris()), 1);
   for (const Sample& x : s.samples)
     if (const auto* r = std::get_if<GnssRawSample>(&x)) engine.feed(*r);
   engine.flush();
-  std::vector<double> err;
+  std::vector<Eigen::Vector2d> err;
   for (const gnss::EpochSolution& sol : engine.take_solutions()) {
     if (!sol.spp_ok) continue;
     auto it = std::lower_bound(s.truth.begin(), s.truth.end(), sol.t_ns,
@@ -113,9 +115,20 @@ TEST(PhoneSession, GnssEngineSolvesTheRawRowsNearTheTruth) {
     const TruthPoint& b = *it;
     const TruthPoint& a = *(it - 1);
     const double w = ns_to_s(sol.t_ns - a.t_ns) / ns_to_s(b.t_ns - a.t_ns);
-    const Eigen::Vector2d truth = a.en_m + w * (b.en_m - a.en_m);
-    err.push_back((dem.to_local(geo::to_geodetic(sol.spp)) - truth).norm());
+    err.push_back(dem.to_local(geo::to_geodetic(sol.spp)) - (a.en_m + w * (b.en_m - a.en_m)));
   }
+  return err;
+}
+
+// The Raw rows are real Android measurements of the real broadcast sky: the project's GNSS
+// engine (which knows nothing of the simulator) solves them near the truth in open sky.
+TEST(PhoneSession, GnssEngineSolvesTheRawRowsNearTheTruth) {
+  const terrain::Dem dem = test::synthetic_dem(534, 534, 30.0, [](double, double) { return 1200.0; });
+  const route::WalkGraph graph = street_grid(5000.0, 200.0);
+  SessionOptions o = open_sky_session();
+  const PhoneSession s = simulate_session(dem, graph, gsdc_ephemeris(), o, 11);
+  std::vector<double> err;
+  for (const Eigen::Vector2d& e : spp_errors_en(s, dem)) err.push_back(e.norm());
   ASSERT_GT(err.size(), 150u);
   std::sort(err.begin(), err.end());
   const double p50 = err[err.size() / 2], p95 = err[err.size() * 95 / 100];
@@ -124,25 +137,13 @@ TEST(PhoneSession, GnssEngineSolvesTheRawRowsNearTheTruth) {
   EXPECT_LT(p95, 20.0);
 }
 
-/// Mean horizontal error (east, north) of the GNSS engine's SPP fixes against the session's truth.
+/// Mean of spp_errors_en; n = how many fixes.
 Eigen::Vector2d mean_spp_error(const PhoneSession& s, const terrain::Dem& dem, std::size_t* n) {
-  gnss::GnssEngine engine(gnss::GnssOptions{}, std::make_shared<gnss::EphemerisStore>(gsdc_ephemeris()), 1);
-  for (const Sample& x : s.samples)
-    if (const auto* r = std::get_if<GnssRawSample>(&x)) engine.feed(*r);
-  engine.flush();
+  const std::vector<Eigen::Vector2d> err = spp_errors_en(s, dem);
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-  *n = 0;
-  for (const gnss::EpochSolution& sol : engine.take_solutions()) {
-    if (!sol.spp_ok) continue;
-    auto it = std::lower_bound(s.truth.begin(), s.truth.end(), sol.t_ns,
-                               [](const TruthPoint& p, TimeNs t) { return p.t_ns < t; });
-    if (it == s.truth.begin() || it == s.truth.end()) continue;
-    const double w = ns_to_s(sol.t_ns - (it - 1)->t_ns) / ns_to_s(it->t_ns - (it - 1)->t_ns);
-    const Eigen::Vector2d truth = (it - 1)->en_m + w * (it->en_m - (it - 1)->en_m);
-    sum += dem.to_local(geo::to_geodetic(sol.spp)) - truth;
-    ++*n;
-  }
-  return *n > 0 ? Eigen::Vector2d(sum / static_cast<double>(*n)) : sum;
+  for (const Eigen::Vector2d& e : err) sum += e;
+  *n = err.size();
+  return err.empty() ? sum : Eigen::Vector2d(sum / static_cast<double>(err.size()));
 }
 
 // The ionosphere's horizontal gradient (a delay growing toward one side of the sky, which the
@@ -151,9 +152,7 @@ Eigen::Vector2d mean_spp_error(const PhoneSession& s, const terrain::Dem& dem, s
 TEST(PhoneSession, TheIonosphericGradientBiasesTheFixesAwayFromIt) {
   const terrain::Dem dem = test::synthetic_dem(534, 534, 30.0, [](double, double) { return 1200.0; });
   const route::WalkGraph graph = street_grid(5000.0, 200.0);
-  SessionOptions o = short_session();
-  o.degraded_segments = 0;
-  o.dem_error.forest_fraction = 0.0;
+  SessionOptions o = open_sky_session();
   o.gnss.iono_gradient_sd_m_per_km = 0.0;
   const PhoneSession flat = simulate_session(dem, graph, gsdc_ephemeris(), o, 11);
   o.gnss.iono_gradient_sd_m_per_km = 3e-3;
