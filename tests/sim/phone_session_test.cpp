@@ -125,8 +125,7 @@ std::vector<Eigen::Vector2d> spp_errors_en(const PhoneSession& s, const terrain:
 TEST(PhoneSession, GnssEngineSolvesTheRawRowsNearTheTruth) {
   const terrain::Dem dem = test::synthetic_dem(534, 534, 30.0, [](double, double) { return 1200.0; });
   const route::WalkGraph graph = street_grid(5000.0, 200.0);
-  SessionOptions o = open_sky_session();
-  const PhoneSession s = simulate_session(dem, graph, gsdc_ephemeris(), o, 11);
+  const PhoneSession s = simulate_session(dem, graph, gsdc_ephemeris(), open_sky_session(), 11);
   std::vector<double> err;
   for (const Eigen::Vector2d& e : spp_errors_en(s, dem)) err.push_back(e.norm());
   ASSERT_GT(err.size(), 150u);

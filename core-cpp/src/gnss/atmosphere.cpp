@@ -14,10 +14,15 @@ double polynomial(const std::array<double, 4>& c, double x) {
 }
 }  // namespace
 
+PiercePoint klobuchar_pierce_point(double el_rad) {
+  const double el_sc = std::max(el_rad, 0.0) / kGpsPi;  // semicircles
+  return PiercePoint{0.0137 / (el_sc + 0.11) - 0.022, 1.0 + 16.0 * std::pow(0.53 - el_sc, 3)};
+}
+
 double klobuchar_delay_s(const KlobucharParams& p, const geo::Geodetic& rx, double az_rad, double el_rad,
                          double gps_tow_s) {
-  const double el_sc = std::max(el_rad, 0.0) / kGpsPi;  // semicircles
-  const double psi = 0.0137 / (el_sc + 0.11) - 0.022;   // Earth-centred angle
+  const PiercePoint ipp = klobuchar_pierce_point(el_rad);
+  const double psi = ipp.earth_angle_sc;
   double phi_i = rx.lat_rad / kGpsPi + psi * std::cos(az_rad);
   phi_i = std::clamp(phi_i, -0.416, 0.416);
   const double lambda_i = rx.lon_rad / kGpsPi + psi * std::sin(az_rad) / std::cos(phi_i * kGpsPi);
@@ -25,7 +30,7 @@ double klobuchar_delay_s(const KlobucharParams& p, const geo::Geodetic& rx, doub
   double t = 4.32e4 * lambda_i + gps_tow_s;
   t = std::fmod(t, 86400.0);
   if (t < 0) t += 86400.0;
-  const double f = 1.0 + 16.0 * std::pow(0.53 - el_sc, 3);
+  const double f = ipp.obliquity;
   const double amp = std::max(polynomial(p.alpha, phi_m), 0.0);
   const double per = std::max(polynomial(p.beta, phi_m), 72000.0);
   const double x = 2.0 * kGpsPi * (t - 50400.0) / per;

@@ -181,16 +181,12 @@ struct Channel {
 };
 
 /// Slant delay (m) of a horizontal gradient g (east, north; m of vertical delay per km) of the
-/// vertical ionospheric delay, evaluated at the pierce point of a satellite at (az, el): the
-/// Earth-central angle to a 350 km shell and the obliquity factor of the broadcast model
-/// (IS-GPS-200 20.3.3.5.2.5: psi = 0.0137 / (E + 0.11) - 0.022, F = 1 + 16 (0.53 - E)^3, E in
-/// semicircles).
+/// vertical ionospheric delay, evaluated at the pierce point of a satellite at (az, el), with the
+/// broadcast model's pierce-point angle and obliquity (gnss::klobuchar_pierce_point).
 double iono_gradient_slant_m(const Eigen::Vector2d& g_m_per_km, double az_rad, double el_rad) {
-  const double e_sc = el_rad / kPi;
-  const double psi_sc = std::max(0.0, 0.0137 / (e_sc + 0.11) - 0.022);
-  const double d_km = psi_sc * kPi * 6371.0;
-  const double obliquity = 1.0 + 16.0 * std::pow(0.53 - e_sc, 3);
-  return obliquity * d_km * (g_m_per_km.x() * std::sin(az_rad) + g_m_per_km.y() * std::cos(az_rad));
+  const gnss::PiercePoint ipp = gnss::klobuchar_pierce_point(el_rad);
+  const double d_km = std::max(0.0, ipp.earth_angle_sc) * kPi * 6371.0;
+  return ipp.obliquity * d_km * (g_m_per_km.x() * std::sin(az_rad) + g_m_per_km.y() * std::cos(az_rad));
 }
 
 }  // namespace

@@ -18,6 +18,16 @@ struct KlobucharParams {
 double klobuchar_delay_s(const KlobucharParams& p, const geo::Geodetic& rx, double az_rad,
                          double el_rad, double gps_tow_s);
 
+/// The broadcast model's geometry of a satellite at elevation el (IS-GPS-200 20.3.3.5.2.5):
+/// the Earth-centred angle from the receiver to the ionospheric pierce point, psi = 0.0137 /
+/// (E + 0.11) - 0.022 semicircles, and the obliquity factor F = 1 + 16 (0.53 - E)^3 (E =
+/// elevation in semicircles, clamped at 0).
+struct PiercePoint {
+  double earth_angle_sc = 0.0;
+  double obliquity = 1.0;
+};
+PiercePoint klobuchar_pierce_point(double el_rad);
+
 /// Saastamoinen zenith delays with the standard atmosphere at the receiver height
 /// (Saastamoinen 1972; P = 1013.25 (1 - 2.2557e-5 h)^5.2568 hPa, T = 15 - 6.5e-3 h deg C).
 struct TroposphereZenith {
