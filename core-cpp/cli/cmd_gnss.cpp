@@ -203,7 +203,7 @@ void write_csv(const std::string& path, const std::vector<gnss::EpochSolution>& 
        "kf_ok,kf_lat_deg,kf_lon_deg,kf_h_m,kf_e_m,kf_n_m,kf_u_m,kf_sigma_e_m,kf_sigma_n_m,kf_sigma_u_m,kf_accepted,"
        "disp_source,disp_dt_s,disp_e_m,disp_n_m,disp_u_m,tdcp_sats,sats_tracked,sats_used";
   for (auto c : kSystems) f << ",sats_" << gnss::to_string(c);
-  f << "\n";
+  f << ",spp_sigma_e_m,spp_sigma_n_m,spp_chi2_per_dof\n";
   char buf[64];
   auto num = [&](double v, const char* fmt) { std::snprintf(buf, sizeof buf, fmt, v); return std::string(std::isfinite(v) ? buf : ""); };
   for (const auto& s : sols) {
@@ -226,6 +226,9 @@ void write_csv(const std::string& path, const std::vector<gnss::EpochSolution>& 
     else f << ",,,";
     f << "," << s.tdcp_sats << "," << s.sats_tracked << "," << s.sats_used;
     for (auto c : kSystems) { auto it = s.used_by_sys.find(c); f << "," << (it == s.used_by_sys.end() ? 0 : it->second); }
+    if (s.spp_ok) f << "," << num(std::sqrt(s.spp_cov_enu(0, 0)), "%.3f") << "," << num(std::sqrt(s.spp_cov_enu(1, 1)), "%.3f")
+                    << "," << num(s.spp_variance_factor, "%.3f");
+    else f << ",,,";
     f << "\n";
   }
 }

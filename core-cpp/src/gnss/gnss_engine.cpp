@@ -15,6 +15,12 @@ void merge(std::map<std::string, std::int64_t>& into, const std::map<std::string
   for (const auto& [k, v] : from) into[k] += v;
 }
 
+/// chi2 / dof of an SPP fit (Teunissen 2003 Sec. 4.3), NaN without redundancy.
+double spp_variance_factor(const SppSolution& spp) {
+  const int dof = static_cast<int>(spp.used.size()) - 4 - static_cast<int>(spp.isb_m.size() + spp.isb_l5_m.size());
+  return dof > 0 ? spp.chi2 / dof : kNaN;
+}
+
 }  // namespace
 
 struct GnssEngine::Impl {
@@ -170,6 +176,9 @@ struct GnssEngine::Impl {
       sol.spp = spp.pos;
       sol.hdop = spp.hdop;
       sol.pdop = spp.pdop;
+      const Eigen::Matrix3d r = geo::ecef_to_enu_rotation(geo::to_geodetic(spp.pos));
+      sol.spp_cov_enu = r * spp.pos_cov_ecef * r.transpose();
+      sol.spp_variance_factor = spp_variance_factor(spp);
       sol.sats_used = static_cast<int>(spp.used.size());
       sol.used_by_sys = spp.used_by_sys();
       if (!have_pos) { last_pos = spp.pos; have_pos = true; }
@@ -279,8 +288,8 @@ struct GnssEngine::Impl {
       const bool was_initialized = kf.initialized();
       // R = the SPP covariance scaled by its a-posteriori variance factor chi2/dof (at least 1):
       // the a-priori C/N0 model does not know the multipath of a moving phone, the residuals do
-      const int dof = static_cast<int>(spp.used.size()) - 4 - static_cast<int>(spp.isb_m.size() + spp.isb_l5_m.size());
-      const double vf = opt.scale_fix_by_variance_factor && dof > 0 ? std::max(1.0, spp.chi2 / dof) : 1.0;
+      const double vf_fit = spp_variance_factor(spp);
+      const double vf = opt.scale_fix_by_variance_factor && std::isfinite(vf_fit) ? std::max(1.0, vf_fit) : 1.0;
       const double since_fix_s = last_fix_gps_ns != 0 ? static_cast<double>(sol.gps_ns - last_fix_gps_ns) * 1e-9 : 1.0;
       last_fix_gps_ns = sol.gps_ns;
       const KalmanUpdateResult u =

@@ -47,6 +47,8 @@ struct EpochSolution {
   bool spp_ok = false;
   std::string spp_reason;                   // why not ok
   double hdop = 0.0, pdop = 0.0;
+  Eigen::Matrix3d spp_cov_enu = Eigen::Matrix3d::Identity();  // m^2, the SPP's a-priori (code noise model) covariance
+  double spp_variance_factor = kNaN;        // chi2 / dof of the SPP fit (NaN without redundancy)
   Eigen::Vector3d tdcp_disp_m = Eigen::Vector3d::Zero();  // ENU displacement since the previous epoch
   bool tdcp_ok = false;
   std::string disp_source;                  // "tdcp", "doppler" or "" (none)
