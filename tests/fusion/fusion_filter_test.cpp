@@ -117,6 +117,41 @@ TEST(FusionFilter, TdcpDisplacementCorrectsTheStepLength) {
   EXPECT_NEAR(f.scale_error(), 0.8 / 0.7 - 1.0, 0.02);
 }
 
+// Issue 27: a direct step-scale sample (the route engine's two matched turns) moves the residual
+// scale and nothing else; the steps after it are corrected; a sample beyond 3 sigma is refused.
+TEST(FusionFilter, AStepScaleSampleMovesOnlyTheScale) {
+  FusionFilter f;
+  f.initialize(Eigen::Vector2d::Zero(), 3.0, 0);
+  TimeNs t = 0;
+  auto walk = [&](int n) {
+    for (int k = 0; k < n; ++k) {
+      t += 500 * kNsPerMs;
+      PdrStep s;
+      s.t_ns = t;
+      s.length_m = 0.7;
+      s.heading_rad = 0.0;
+      s.length_sigma_m = 0.05;
+      s.heading_sigma_rad = 0.05;
+      f.predict(s);
+    }
+  };
+  walk(100);
+  const Eigen::Vector2d p0 = f.position_en_m();
+  const double var0 = f.scale_error_var();
+  ASSERT_GT(var0, 0.01);  // the unknown walker's prior (18 %)
+  double nis = 0.0;
+  EXPECT_FALSE(f.update_scale(t, 1.0, 0.05 * 0.05, &nis));  // 100 % longer: beyond the gate
+  EXPECT_GT(nis, 9.0);
+  EXPECT_TRUE(f.update_scale(t, 0.15, 0.05 * 0.05, &nis));
+  EXPECT_NEAR(f.scale_error(), 0.15 * var0 / (var0 + 0.0025), 1e-9);  // the scalar Kalman gain
+  EXPECT_NEAR(f.scale_error_var(), var0 * 0.0025 / (var0 + 0.0025), 1e-9);
+  EXPECT_EQ(f.position_en_m(), p0);  // the position is not moved by it
+  const double ds = f.scale_error();
+  walk(10);  // (the Gauss-Markov scale fades by exp(-5 s / 300 s) meanwhile)
+  EXPECT_NEAR(f.position_en_m().y() - p0.y(), 10 * 0.7 * (1.0 + ds), 0.01);
+  EXPECT_GT(ds, 0.13);
+}
+
 // Issue 14: an already-filtered GNSS position (the engine's KF) is time-correlated, so a run of
 // them never makes the fused position more certain than one of them: with floor_fraction 1
 // the position covariance stays >= R; the default (0.25) lets it fall to R / 4.

@@ -357,6 +357,26 @@ PositionUpdateResult FusionFilter::update_position_ci(TimeNs t_ns, const Eigen::
   return res;
 }
 
+bool FusionFilter::update_scale(TimeNs t_ns, double ds, double var, double* nis_out) {
+  if (!initialized_ || !std::isfinite(ds) || !(var > 0.0) || !std::isfinite(var)) return false;
+  advance_to(t_ns);
+  const double nu = ds - x_(3);
+  const double s = p_(3, 3) + var;
+  const double nis = nu * nu / s;
+  if (nis_out) *nis_out = nis;
+  if (nis > opt_.scale_gate_chi2) return false;
+  // only ds moves (Schmidt: the position is the position measurements' business; the map's turns
+  // already reached it through the route engine's estimate); the Joseph form keeps P right
+  Vec6 k = Vec6::Zero();
+  k(3) = p_(3, 3) / s;
+  x_ += k * nu;
+  Mat6 ikh = Mat6::Identity();
+  ikh.col(3) -= k;
+  p_ = (ikh * p_ * ikh.transpose() + var * k * k.transpose()).eval();
+  symmetrize();
+  return true;
+}
+
 bool FusionFilter::update_displacement(TimeNs t_ns, TimeNs from_ns, const Eigen::Vector2d& d_en_m, const Eigen::Matrix2d& r_in,
                                        double* nis_out) {
   if (!initialized_ || !clone_ok_ || std::llabs(from_ns - clone_t_ns_) > 50 * kNsPerMs || !d_en_m.allFinite() ||

@@ -67,6 +67,7 @@ FusionOptions fusion_options_before_issue28() {
   o.calibration.use_course = false;
   o.calibration.use_speed = false;
   o.route_scale_from_filter = false;
+  o.route_scale_samples = false;
   o.filter.scale_within_walk_sigma = 0.0;
   return o;
 }
@@ -462,6 +463,7 @@ struct Navigator::Impl {
     if (route) route->feed(c);
     for (const PdrTurn& t : pdr.take_turns())
       if (route) route->feed(t);
+    if (route) route_scale(c.t_ns);
     engine_aid(c.t_ns);
     refresh_mode(c.t_ns);
     update_shown(c.t_ns);
@@ -648,6 +650,22 @@ struct Navigator::Impl {
     }
     route_misses = terrain_misses = 0;
     ++counts["engines re-anchored to the fused estimate"];
+  }
+
+  /// In an outage, a step-scale sample of the route engine (two matched turns) is a direct
+  /// measurement of the filter's residual scale (the steps it was fed are the calibrated ones).
+  void route_scale(TimeNs t) {
+    const std::optional<route::RouteScaleSample> s = route->take_scale_sample();
+    if (!s || !fo().route_scale_samples || t - s->t_ns > ns(30.0)) return;  // (a stale one: taken before the fused start)
+    if (last_gnss_ns >= 0 && t - last_gnss_ns < ns(fo().aid_after_s)) return;  // GNSS calibrates the scale
+    double nis = 0.0;
+    if (ff.update_scale(t, s->scale - 1.0, s->sigma * s->sigma, &nis)) {
+      ++counts["route: step scale from two matched turns used"];
+      last_event = "route: the map's path between two turns is " + fmt(100.0 * (s->scale - 1.0)) + " % longer than " +
+                   fmt(s->distance_m) + " m of steps (+- " + fmt(100.0 * s->sigma) + " %): scale updated";
+    } else {
+      ++counts["route: step scale from two matched turns rejected (gate)"];
+    }
   }
 
   /// In an outage, the route and terrain engines' estimates are measurements.

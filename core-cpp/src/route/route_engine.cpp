@@ -71,6 +71,10 @@ Eigen::Vector2d RouteEngine::position(const Route& r) const {
   return s.a_en_m + std::min(r.offset_m, s.length_m) * s.dir;
 }
 
+double RouteEngine::rank(const Route& r) {
+  return r.log_w - 0.5 * (r.stuck_m / kStuckSigma_m) * (r.stuck_m / kStuckSigma_m);
+}
+
 void RouteEngine::remember(Route& r, std::int32_t node, std::int32_t in_seg, double odo_m) {
   if (r.n_passed == r.passed.size()) {
     std::rotate(r.passed.begin(), r.passed.begin() + 1, r.passed.end());
@@ -203,8 +207,16 @@ bool RouteEngine::local_restart() {
 // tolerance (ahead along shallow continuations, or already passed) whose map turn angle
 // matches the reported one within the angle tolerance. It snaps to that node.
 void RouteEngine::branch_at(const Route& r, std::int32_t node, std::int32_t in_seg, double turn_rad,
-                            double d_after_m, double snap_m, std::vector<Route>& out) const {
+                            double d_after_m, double snap_m, double along_m, TimeNs mid_ns, std::vector<Route>& out) const {
   const double snap_sigma = std::hypot(kSnapSigmaFloor_m, kStepScaleSigma * r.since_snap_m);
+  // since the previous matched turn the route has moved along the graph with the steps, so the
+  // path from that turn's node to this one is (odometer since) + along_m (ahead +, passed -);
+  // the steps made that distance up to the middle of this turn
+  double path_m = -1.0, steps_m = 0.0;
+  if (r.snap_odo_m >= 0.0 && r.stuck_m <= 0.0) {
+    path_m = r.odo_m - r.snap_odo_m + along_m;
+    steps_m = r.odo_m - d_after_m - r.snap_odo_m;
+  }
   for (const auto o : graph_->out_segments(node)) {
     const double diff = std::abs(wrap_pi(map_turn_rad(in_seg, o) - turn_rad));
     if (diff > opt_.angle_tolerance_rad) continue;
@@ -212,13 +224,18 @@ void RouteEngine::branch_at(const Route& r, std::int32_t node, std::int32_t in_s
     n.seg = o;
     n.odo_m = r.odo_m - d_after_m;
     n.turn_free_until_m = n.odo_m + opt_.turn_window_m;
+    n.snap_odo_m = n.odo_m;
+    n.snap_t_ns = mid_ns;
+    n.sample_path_m = path_m;
+    n.sample_steps_m = steps_m;
+    n.sample_from_ns = r.snap_t_ns;
     n.log_w = r.log_w - 0.5 * (diff / kTurnAngleSigma_rad) * (diff / kTurnAngleSigma_rad) -
               0.5 * (snap_m / snap_sigma) * (snap_m / snap_sigma);
     advance(n, d_after_m, out);
   }
 }
 
-void RouteEngine::turn_candidates_ahead(const Route& r, double turn_rad, double d_after_m,
+void RouteEngine::turn_candidates_ahead(const Route& r, double turn_rad, double d_after_m, TimeNs mid_ns,
                                         std::vector<Route>& out) const {
   const WalkGraph& g = *graph_;
   struct Item { std::int32_t in_seg; double dist_m; int depth; };
@@ -230,7 +247,7 @@ void RouteEngine::turn_candidates_ahead(const Route& r, double turn_rad, double 
     work.pop_back();
     if (it.dist_m > opt_.distance_tolerance_m) continue;
     const auto& s = g.segment(it.in_seg);
-    branch_at(r, s.to, it.in_seg, turn_rad, d_after_m, it.dist_m, out);
+    branch_at(r, s.to, it.in_seg, turn_rad, d_after_m, it.dist_m, it.dist_m, mid_ns, out);
     if (it.depth >= kAheadDepth) continue;
     for (const auto o : g.out_segments(s.to)) {
       if (!is_shallow(it.in_seg, o)) continue;
@@ -251,26 +268,61 @@ void RouteEngine::feed(const PdrTurn& turn) {
     if (t > mid) d_after += len;
   }
   const double turn_rad = turn.angle_rad;
-  std::vector<Route> next = apply_turn(turn_rad, d_after);
+  std::vector<Route> next = apply_turn(turn_rad, d_after, mid);
   if (next.empty() && local_restart()) {
     // Re-seeded around the last estimate: the turn just reported locates the walker.
-    next = apply_turn(turn_rad, d_after);
+    next = apply_turn(turn_rad, d_after, mid);
     if (next.empty()) return;  // keep the fresh routes; the next turn or fix prunes them
   }
   routes_.swap(next);
   merge_and_bound();
   update_clusters();
+  publish_scale_sample(mid);
 }
 
-std::vector<RouteEngine::Route> RouteEngine::apply_turn(double turn_rad, double d_after) const {
+// The step scale the map measured between this turn and the previous matched one: over the
+// routes of the leading cluster that carry a sample, G / D with their weights; none when the
+// turn left the clusters ambiguous or the sample is shorter than scale_sample_min_m.
+void RouteEngine::publish_scale_sample(TimeNs t_ns) {
+  if (routes_.empty() || clusters_.empty()) return;
+  if (clusters_.size() > 1 && clusters_[1].weight > opt_.ambiguity_ratio * clusters_[0].weight) return;
+  const double r2 = opt_.cluster_radius_m * opt_.cluster_radius_m;
+  double w_all = 0.0, w_s = 0.0, wg = 0.0, wd = 0.0, w_best = -1.0;
+  TimeNs from_ns = 0;
+  for (const Route& r : routes_) {
+    if ((position(r) - clusters_.front().mean_en_m).squaredNorm() > r2) continue;
+    const double w = std::exp(rank(r));
+    w_all += w;
+    if (!(r.sample_path_m > 0.0) || !(r.sample_steps_m >= opt_.scale_sample_min_m)) continue;
+    w_s += w;
+    wg += w * r.sample_path_m;
+    wd += w * r.sample_steps_m;
+    if (w > w_best) w_best = w, from_ns = r.sample_from_ns;
+  }
+  // most of the leading cluster must have come from a matched turn (not a fix or a restart)
+  if (!(w_s > 0.5 * w_all) || !(wd > 0.0)) return;
+  const double g = wg / w_s, d = wd / w_s;
+  // the ends' along-track error; the steps' stated length sigma is not added: it is mostly the
+  // scale error being measured, not noise of the sum
+  const double var_g = 2.0 * opt_.turn_position_sigma_m * opt_.turn_position_sigma_m;
+  RouteScaleSample s;
+  s.from_ns = from_ns;
+  s.t_ns = t_ns;
+  s.scale = g / d;
+  s.sigma = std::hypot(std::sqrt(var_g) / d, opt_.path_length_sigma);
+  s.distance_m = d;
+  scale_sample_ = s;
+}
+
+std::vector<RouteEngine::Route> RouteEngine::apply_turn(double turn_rad, double d_after, TimeNs mid_ns) const {
   std::vector<Route> next;
   for (const auto& r : routes_) {
     for (std::uint8_t i = 0; i < r.n_passed; ++i) {
       const double back_m = r.odo_m - r.passed[i].odo_m;
       if (back_m > opt_.distance_tolerance_m) continue;
-      branch_at(r, r.passed[i].node, r.passed[i].in_seg, turn_rad, d_after, back_m, next);
+      branch_at(r, r.passed[i].node, r.passed[i].in_seg, turn_rad, d_after, back_m, -back_m, mid_ns, next);
     }
-    turn_candidates_ahead(r, turn_rad, d_after, next);
+    turn_candidates_ahead(r, turn_rad, d_after, mid_ns, next);
   }
   return next;
 }
@@ -347,6 +399,8 @@ void RouteEngine::reseed_along_track(const Eigen::Vector2d& p, double sigma_m, d
       const double p_var = 1.0 + kStepScaleSigma * kStepScaleSigma * parent->since_snap_m * parent->since_snap_m;
       const double post_var = p_var * r_var / (p_var + r_var);
       Route c = *parent;
+      c.snap_odo_m = -1.0;  // moved to the fix: its path since the last turn is not the graph's
+      c.sample_path_m = -1.0;
       c.seg = sid;
       c.offset_m = off;
       c.stuck_m = 0.0;
@@ -364,8 +418,7 @@ void RouteEngine::merge_and_bound() {
   const double q = opt_.merge_spacing_m;
   auto key = [q](const Route& r) { return std::make_pair(r.seg, static_cast<std::int64_t>(std::floor(r.offset_m / q))); };
   auto better = [](const Route& a, const Route& b) {
-    return a.log_w - 0.5 * (a.stuck_m / kStuckSigma_m) * (a.stuck_m / kStuckSigma_m) >
-           b.log_w - 0.5 * (b.stuck_m / kStuckSigma_m) * (b.stuck_m / kStuckSigma_m);
+    return rank(a) > rank(b);
   };
   std::sort(routes_.begin(), routes_.end(), [&](const Route& a, const Route& b) {
     const auto ka = key(a), kb = key(b);
@@ -395,7 +448,7 @@ void RouteEngine::update_clusters() {
   std::vector<double> w(routes_.size());
   for (std::size_t i = 0; i < routes_.size(); ++i) {
     const auto& r = routes_[i];
-    w[i] = std::exp(r.log_w - 0.5 * (r.stuck_m / kStuckSigma_m) * (r.stuck_m / kStuckSigma_m));
+    w[i] = std::exp(rank(r));
   }
   std::vector<std::size_t> order(routes_.size());
   std::iota(order.begin(), order.end(), 0);
@@ -488,7 +541,7 @@ std::vector<Candidate> RouteEngine::candidates(std::size_t max) const {
     c.heading_rad = s.heading_rad;
     c.edge = s.edge;
     c.distance_error_m = r.stuck_m;
-    c.weight = std::exp(r.log_w - 0.5 * (r.stuck_m / kStuckSigma_m) * (r.stuck_m / kStuckSigma_m));
+    c.weight = std::exp(rank(r));
     total += c.weight;
     out.push_back(c);
   }

@@ -72,6 +72,7 @@ struct FusionFilterOptions {
   double reacquire_after_s = 30.0;   // no accepted position this long = an outage
   int reacquire_epochs = 2;          // after an outage, this many agreeing epochs before use
   double displacement_gate_chi2 = 13.82;  // TDCP / Doppler: chi^2(2) at 99.9 % (cycle slips)
+  double scale_gate_chi2 = 9.0;           // a direct step-scale sample: chi^2(1) at 99.73 % (3 sigma)
   /// Phone code errors are time-correlated (multipath, minutes): after a position update the
   /// position variance is kept >= this fraction of the measurement's, so a run of correlated
   /// fixes never claims they averaged out (beyond the paper; docs/fusion.md). 0 = off.
@@ -132,6 +133,11 @@ class FusionFilter {
   /// the position rows/columns of P are scaled by 1/sqrt(w) and R by 1/(1 - w) before a Kalman
   /// update, which stays consistent for any cross-correlation. Gated at gate_chi2 on P_pos + R.
   PositionUpdateResult update_position_ci(TimeNs t_ns, const Eigen::Vector2d& z_en_m, const Eigen::Matrix2d& r_m2);
+  /// A direct sample of the residual step-scale error `ds` (true step = (1 + ds) x the fed
+  /// step), e.g. the map's path between two matched turns over the steps' distance, minus 1;
+  /// gated at scale_gate_chi2; only `ds` is updated (its gain on the other states is zero).
+  /// Returns accepted.
+  bool update_scale(TimeNs t_ns, double ds, double var, double* nis = nullptr);
   /// Displacement since the clone (the last GNSS epoch), e.g. TDCP. Returns accepted.
   bool update_displacement(TimeNs t_ns, TimeNs from_ns, const Eigen::Vector2d& d_en_m, const Eigen::Matrix2d& r_m2,
                            double* nis = nullptr);

@@ -88,6 +88,10 @@ struct FusionOptions {
   /// metres while its along-track error reached 100 m (docs/fusion.md). false = 5 %.
   bool route_scale_from_filter = true;
   bool aid_with_terrain = true;
+  /// In an outage the route engine's step-scale samples (the path between two matched turns
+  /// over the steps' distance, RouteScaleSample) update the filter's residual scale `ds`: the
+  /// step length learned where the map constrains it (issue 27).
+  bool route_scale_samples = true;
   int wrong_lock_after = 3;           // engine rejected this many times in a row: re-anchored
   // blending of the shown position
   double blend_above_sigma = 1.0;     // corrections larger than this (sigma) are blended in

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -43,6 +44,28 @@ struct RouteOptions {
   bool use_step_heading = true;
   double default_heading_sigma_rad = deg_to_rad(25.0);
   double heading_memory = 0.95;      // per-step forgetting of the heading log-likelihood
+  /// Step scale from the map (issue 27: step length learned where the map constrains it; APT's
+  /// turn snapping gives it): between two matched turns the path length along the graph G and
+  /// the distance the fed steps made D give a sample G / D. Published when D >= this and the
+  /// turn leaves one cluster (not ambiguous).
+  double scale_sample_min_m = 40.0;
+  /// 1-sigma of where a matched turn puts the walker along the path, at each end of a sample
+  /// (the demo's route eval, error right after a turn: median 0.83 m, p95 2.87 m: ~1 m per axis).
+  double turn_position_sigma_m = 1.0;
+  /// Relative 1-sigma of a walked path against its graph polyline (corners cut or widened, the
+  /// walker beside the centreline, simplified ways), added to every sample. 5 %: the samples'
+  /// scatter on simulated phone sessions (p10 / p90 -8.7 / +5.9 %, docs/route.md); no real walk
+  /// on a graph is shared to measure it.
+  double path_length_sigma = 0.05;
+};
+
+/// A step-scale sample from two matched turns (RouteOptions::scale_sample_min_m).
+struct RouteScaleSample {
+  TimeNs from_ns = 0;        // the middle of the first turn
+  TimeNs t_ns = 0;           // ... of the second
+  double scale = 1.0;        // path length along the graph / distance of the fed steps
+  double sigma = 0.0;        // 1-sigma of `scale`
+  double distance_m = 0.0;   // distance of the fed steps between the two turns
 };
 
 /// One live hypothesis, for display and for fusion.
@@ -74,6 +97,8 @@ class RouteEngine {
   /// Navigator sets it before each step to the fusion filter's residual scale sigma (the steps
   /// it feeds are calibrated); <= 0 (the default) = 5 %, the constant the ranking uses too.
   void set_step_scale_sigma(double sigma) { step_scale_sigma_ = sigma; }
+  /// The step-scale sample of the last turn, once (then empty until the next one).
+  std::optional<RouteScaleSample> take_scale_sample() { auto s = scale_sample_; scale_sample_.reset(); return s; }
   std::size_t route_count() const { return routes_.size(); }
   std::size_t restarts() const { return restarts_; }            // from a GNSS fix
   std::size_t local_restarts() const { return local_restarts_; }  // around the last estimate
@@ -94,6 +119,10 @@ class RouteEngine {
     double since_snap_m = 0.0; // distance walked since the last snap (init or turn)
     double log_w = 0.0;        // ranking log-likelihood (heading, fix distance)
     double turn_free_until_m = -1.0;  // odometer up to which a matched turn's bends are free
+    double snap_odo_m = -1.0;  // odometer at the last matched turn's node (< 0: none since the route began)
+    TimeNs snap_t_ns = 0;      // ... the middle of that turn
+    double sample_path_m = -1.0, sample_steps_m = 0.0;  // G and D at that turn (G < 0: none)
+    TimeNs sample_from_ns = 0;
     std::array<Passed, 4> passed{};
     std::uint8_t n_passed = 0;
   };
@@ -108,19 +137,21 @@ class RouteEngine {
   void initialise(const Eigen::Vector2d& p_en_m, double sigma_m, double radius_m);
   void advance(Route r, double d_m, std::vector<Route>& out) const;
   void branch_at(const Route& r, std::int32_t node, std::int32_t in_seg, double turn_rad,
-                 double d_after_m, double snap_m, std::vector<Route>& out) const;
-  void turn_candidates_ahead(const Route& r, double turn_rad, double d_after_m, std::vector<Route>& out) const;
+                 double d_after_m, double snap_m, double along_m, TimeNs mid_ns, std::vector<Route>& out) const;
+  void publish_scale_sample(TimeNs t_ns);
+  void turn_candidates_ahead(const Route& r, double turn_rad, double d_after_m, TimeNs mid_ns, std::vector<Route>& out) const;
   double bend_rad(std::int32_t in_seg, std::int32_t out_seg) const;
   double tail_bend(std::int32_t seg) const;
   double map_turn_rad(std::int32_t in_seg, std::int32_t out_seg) const;
   bool is_shallow(std::int32_t in_seg, std::int32_t out_seg) const;
-  std::vector<Route> apply_turn(double turn_rad, double d_after_m) const;
+  std::vector<Route> apply_turn(double turn_rad, double d_after_m, TimeNs mid_ns) const;
   bool local_restart();
   void reseed_along_track(const Eigen::Vector2d& p_en_m, double sigma_m, double radius_m,
                           std::vector<Route>& kept) const;
   void merge_and_bound();
   void update_clusters();
   static void remember(Route& r, std::int32_t node, std::int32_t in_seg, double odo_m);
+  static double rank(const Route& r);  // log weight with the overshoot's penalty
 
   RouteOptions opt_;
   std::shared_ptr<const WalkGraph> graph_;
@@ -130,6 +161,7 @@ class RouteEngine {
   std::deque<std::pair<TimeNs, double>> recent_steps_;  // (t, length) for turn snapping
   bool truncated_ = false;
   double step_scale_sigma_ = 0.0;  // set_step_scale_sigma (<= 0: kStepScaleSigma)
+  std::optional<RouteScaleSample> scale_sample_;
   bool initialised_ = false;
   std::size_t restarts_ = 0;
   std::size_t local_restarts_ = 0;
