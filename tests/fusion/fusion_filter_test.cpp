@@ -13,6 +13,17 @@
 namespace pdnav::fusion {
 namespace {
 
+/// A 0.7 m PDR step north at t.
+PdrStep step_north(TimeNs t) {
+  PdrStep s;
+  s.t_ns = t;
+  s.length_m = 0.7;
+  s.heading_rad = 0.0;
+  s.length_sigma_m = 0.05;
+  s.heading_sigma_rad = 0.05;
+  return s;
+}
+
 struct Sim {
   FusionFilter f;
   std::mt19937_64 rng{5};
@@ -102,13 +113,7 @@ TEST(FusionFilter, TdcpDisplacementCorrectsTheStepLength) {
     const TimeNs from = t;
     for (int j = 0; j < 2; ++j) {
       t += 500 * kNsPerMs;
-      PdrStep s;
-      s.t_ns = t;
-      s.length_m = 0.7;
-      s.heading_rad = 0.0;
-      s.length_sigma_m = 0.05;
-      s.heading_sigma_rad = 0.05;
-      f.predict(s);
+      f.predict(step_north(t));
       truth += 0.8;
     }
     EXPECT_TRUE(f.update_displacement(t, from, Eigen::Vector2d(0.0, 1.6), 0.01 * Eigen::Matrix2d::Identity())) << k;
@@ -126,13 +131,7 @@ TEST(FusionFilter, AStepScaleSampleMovesOnlyTheScale) {
   auto walk = [&](int n) {
     for (int k = 0; k < n; ++k) {
       t += 500 * kNsPerMs;
-      PdrStep s;
-      s.t_ns = t;
-      s.length_m = 0.7;
-      s.heading_rad = 0.0;
-      s.length_sigma_m = 0.05;
-      s.heading_sigma_rad = 0.05;
-      f.predict(s);
+      f.predict(step_north(t));
     }
   };
   walk(100);
