@@ -52,6 +52,7 @@ struct Track {
   std::vector<bool> valid;
   std::vector<Eigen::Vector2d> en_m;
   std::vector<Eigen::Matrix2d> cov;
+  std::map<std::string, std::int64_t> counts;  // the Navigator's fusion counts at the end
 };
 
 /// The session through the log writer and reader (in memory, the same text as a file).
@@ -104,6 +105,7 @@ Track replay(const std::vector<Sample>& samples, const fusion::NavigatorConfig& 
       tr.cov.push_back(e.cov_en_m2);
     }
   }
+  for (const auto& [what, n] : nav.fusion_counts()) tr.counts[what] = n;
   return tr;
 }
 
@@ -160,6 +162,7 @@ struct WalkResult {
   std::pair<double, double> cal_dr{kNaNd, kNaNd}, cal_fused{kNaNd, kNaNd};
   phonesim::SessionStats stats;
   std::size_t skipped_lines = 0;
+  std::int64_t route_scale_used = 0, route_scale_rejected = 0;  // the map's step-scale samples in the fused replay
 };
 
 WalkResult evaluate(const phonesim::PhoneSession& ses, const fusion::NavigatorConfig& base, const terrain::Dem& dem,
@@ -243,6 +246,9 @@ WalkResult evaluate(const phonesim::PhoneSession& ses, const fusion::NavigatorCo
   }
   r.cal_dr = track_calibration(dr, truth, out_idx);
   r.cal_fused = track_calibration(fused, truth, out_idx);
+  const auto count = [&](const char* what) { const auto it = fused.counts.find(what); return it == fused.counts.end() ? 0 : it->second; };
+  r.route_scale_used = count(fusion::Navigator::kRouteScaleUsed);
+  r.route_scale_rejected = count(fusion::Navigator::kRouteScaleRejected);
   return r;
 }
 
@@ -304,13 +310,14 @@ int run_eval_fusion(const EvalFusionArgs& a) {
                   f1(rows[s][3].drms_m).c_str(), f1(rows[s][4].drms_m).c_str());
     std::printf("      walk %d (seed %llu): %.0f m, outage %.0f s, %.1f sats; outage_ratio %s, coverage_68 in outage %s, max_jump_sigma %s, reacquire_s %s%s, "
                 "open_sky_ratio %s; calibration over the outage (scale err %%, heading err deg): dr %s/%s fused %s/%s; "
-                "truth: stride %.3f x APT, heading bias at outage %.1f deg\n",
+                "truth: stride %.3f x APT, heading bias at outage %.1f deg; map step-scale samples used %lld (refused %lld)\n",
                 w, static_cast<unsigned long long>(ws), r.length_m, r.outage_s, r.stats.mean_sats_tracked, f3(r.outage_ratio).c_str(),
                 f3(r.out_scored > 0 ? static_cast<double>(r.out_covered_68) / r.out_scored : kNaNd).c_str(),
                 f3(r.max_jump_sigma).c_str(), f1(r.reacquire_s).c_str(), r.reacquire_censored ? " (never, censored)" : "",
                 f3(r.open_sky_ratio).c_str(), f1(100 * r.cal_dr.first).c_str(), f1(r.cal_dr.second).c_str(),
                 f1(100 * r.cal_fused.first).c_str(), f1(r.cal_fused.second).c_str(), r.stats.walker_stride_scale,
-                r.stats.heading_bias_at_outage_deg);
+                r.stats.heading_bias_at_outage_deg, static_cast<long long>(r.route_scale_used),
+                static_cast<long long>(r.route_scale_rejected));
     if (r.skipped_lines > 0) std::printf("      walk %d: %zu log lines skipped by the reader\n", w, r.skipped_lines);
     std::fflush(stdout);
     results.push_back(r);
@@ -323,7 +330,10 @@ int run_eval_fusion(const EvalFusionArgs& a) {
                              " walks could be simulated");
   std::vector<double> ratio, jump, reacq, open, e_out[5], e_after[5];
   int covered = 0, scored = 0;
+  std::int64_t scale_used = 0, scale_refused = 0;
   for (const auto& r : results) {
+    scale_used += r.route_scale_used;
+    scale_refused += r.route_scale_rejected;
     covered += r.out_covered_68;
     scored += r.out_scored;
     ratio.push_back(r.outage_ratio);
@@ -337,6 +347,8 @@ int run_eval_fusion(const EvalFusionArgs& a) {
               med(e_out[1]).c_str(), med(e_out[2]).c_str(), med(e_out[3]).c_str(), med(e_out[4]).c_str());
   std::printf("median DRMS after outages (m):  fused %s dr %s gnss %s terrain %s route %s\n", med(e_after[0]).c_str(),
               med(e_after[1]).c_str(), med(e_after[2]).c_str(), med(e_after[3]).c_str(), med(e_after[4]).c_str());
+  std::printf("the map's step-scale samples (two matched turns) in the fused replays: %lld used, %lld refused by the gate\n",
+              static_cast<long long>(scale_used), static_cast<long long>(scale_refused));
   // the walks far from their peers, with the whole seed (the table's column is cut to 9 digits)
   // and the command that writes that session, to look at one
   std::vector<std::size_t> order(results.size());

@@ -660,11 +660,11 @@ struct Navigator::Impl {
     if (last_gnss_ns >= 0 && t - last_gnss_ns < ns(fo().aid_after_s)) return;  // GNSS calibrates the scale
     double nis = 0.0;
     if (ff.update_scale(t, s->scale - 1.0, s->sigma * s->sigma, &nis)) {
-      ++counts["route: step scale from two matched turns used"];
+      ++counts[Navigator::kRouteScaleUsed];
       last_event = "route: the map's path between two turns is " + fmt(100.0 * (s->scale - 1.0)) + " % longer than " +
                    fmt(s->distance_m) + " m of steps (+- " + fmt(100.0 * s->sigma) + " %): scale updated";
     } else {
-      ++counts["route: step scale from two matched turns rejected (gate)"];
+      ++counts[Navigator::kRouteScaleRejected];
     }
   }
 

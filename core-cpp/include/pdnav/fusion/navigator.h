@@ -206,6 +206,9 @@ class Navigator {
   std::vector<ModeChange> mode_changes() const;
   /// Fusion counters (GNSS rejected by the gate, forced corrections, re-anchors, ...).
   std::vector<std::pair<std::string, std::int64_t>> fusion_counts() const;
+  /// Names of two of them: the route engine's step-scale samples used / refused by the gate.
+  static constexpr const char* kRouteScaleUsed = "route: step scale from two matched turns used";
+  static constexpr const char* kRouteScaleRejected = "route: step scale from two matched turns rejected (gate)";
 
  private:
   struct Impl;
