@@ -459,8 +459,17 @@ struct Navigator::Impl {
     const PdrStep c = calibrated(raw);
     ff.predict(c);
     if (terrain) terrain->feed(c);
-    if (route && fo().route_scale_from_filter) route->set_step_scale_sigma(std::sqrt(std::max(0.0, ff.scale_error_var())));
-    if (route) route->feed(c);
+    if (route && fo().route_scale_from_filter) {
+      // the route's steps carry the filter's residual scale too, so that their scale error is
+      // the one whose sigma it is given (the filter learns ds from TDCP speeds and the map)
+      PdrStep cr = c;
+      cr.length_m *= 1.0 + ff.scale_error();
+      cr.length_sigma_m *= 1.0 + ff.scale_error();
+      route->set_step_scale_sigma(std::sqrt(std::max(0.0, ff.scale_error_var())));
+      route->feed(cr);
+    } else if (route) {
+      route->feed(c);
+    }
     for (const PdrTurn& t : pdr.take_turns())
       if (route) route->feed(t);
     if (route) route_scale(c.t_ns);
@@ -658,8 +667,10 @@ struct Navigator::Impl {
     const std::optional<route::RouteScaleSample> s = route->take_scale_sample();
     if (!s || !fo().route_scale_samples || t - s->t_ns > ns(30.0)) return;  // (a stale one: taken before the fused start)
     if (last_gnss_ns >= 0 && t - last_gnss_ns < ns(fo().aid_after_s)) return;  // GNSS calibrates the scale
+    // the route was fed the filter's corrected steps (x (1 + ds)) when route_scale_from_filter
+    const double fed = fo().route_scale_from_filter ? 1.0 + ff.scale_error() : 1.0;
     double nis = 0.0;
-    if (ff.update_scale(t, s->scale - 1.0, s->sigma * s->sigma, &nis)) {
+    if (ff.update_scale(t, s->scale * fed - 1.0, s->sigma * fed * s->sigma * fed, &nis)) {
       ++counts[Navigator::kRouteScaleUsed];
       last_event = "route: the map's path between two turns is " + fmt(100.0 * (s->scale - 1.0)) + " % longer than " +
                    fmt(s->distance_m) + " m of steps (+- " + fmt(100.0 * s->sigma) + " %): scale updated";
