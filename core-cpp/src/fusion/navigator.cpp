@@ -662,7 +662,8 @@ struct Navigator::Impl {
   }
 
   /// In an outage, a step-scale sample of the route engine (two matched turns) is a direct
-  /// measurement of the filter's residual scale (the steps it was fed are the calibrated ones).
+  /// measurement of the filter's residual scale (the route was fed the calibrated steps, times
+  /// 1 + ds with route_scale_from_filter).
   void route_scale(TimeNs t) {
     const std::optional<route::RouteScaleSample> s = route->take_scale_sample();
     if (!s || !fo().route_scale_samples || t - s->t_ns > ns(30.0)) return;  // (a stale one: taken before the fused start)

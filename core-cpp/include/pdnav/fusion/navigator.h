@@ -85,7 +85,9 @@ struct FusionOptions {
   /// The route engine's along-track covariance grows with the filter's residual scale sigma
   /// (the steps it is fed are calibrated by the same calibration), not APT's fixed 5 %: on
   /// eval-fusion walks whose calibration was learnt on a steeper grade the route claimed a few
-  /// metres while its along-track error reached 100 m (docs/fusion.md). false = 5 %.
+  /// metres while its along-track error reached 100 m (docs/fusion.md). Its steps then carry the
+  /// filter's residual scale too (x (1 + ds)), so that their error is the one that sigma states.
+  /// false = 5 % and the calibrated steps alone.
   bool route_scale_from_filter = true;
   bool aid_with_terrain = true;
   /// In an outage the route engine's step-scale samples (the path between two matched turns

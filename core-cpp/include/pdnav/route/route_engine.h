@@ -95,7 +95,8 @@ class RouteEngine {
   /// 1-sigma of the fed steps' length scale error (fraction), for the along-track part of the
   /// covariance estimate() reports (sigma x the distance since the route's last snap). The
   /// Navigator sets it before each step to the fusion filter's residual scale sigma (the steps
-  /// it feeds are calibrated); <= 0 (the default) = 5 %, the constant the ranking uses too.
+  /// it feeds are calibrated and carry the filter's residual scale); <= 0 (the default) = 5 %,
+  /// the constant the ranking uses too.
   void set_step_scale_sigma(double sigma) { step_scale_sigma_ = sigma; }
   /// The step-scale sample of the last turn, once (then empty until the next one).
   std::optional<RouteScaleSample> take_scale_sample() { auto s = scale_sample_; scale_sample_.reset(); return s; }
