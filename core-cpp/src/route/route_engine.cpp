@@ -207,7 +207,7 @@ bool RouteEngine::local_restart() {
 // tolerance (ahead along shallow continuations, or already passed) whose map turn angle
 // matches the reported one within the angle tolerance. It snaps to that node.
 void RouteEngine::branch_at(const Route& r, std::int32_t node, std::int32_t in_seg, double turn_rad,
-                            double d_after_m, double snap_m, double along_m, TimeNs mid_ns, std::vector<Route>& out) const {
+                            double d_after_m, double snap_m, double along_m, std::vector<Route>& out) const {
   const double snap_sigma = std::hypot(kSnapSigmaFloor_m, kStepScaleSigma * r.since_snap_m);
   // since the previous matched turn the route has moved along the graph with the steps, so the
   // path from that turn's node to this one is (odometer since) + along_m (ahead +, passed -);
@@ -225,17 +225,15 @@ void RouteEngine::branch_at(const Route& r, std::int32_t node, std::int32_t in_s
     n.odo_m = r.odo_m - d_after_m;
     n.turn_free_until_m = n.odo_m + opt_.turn_window_m;
     n.snap_odo_m = n.odo_m;
-    n.snap_t_ns = mid_ns;
     n.sample_path_m = path_m;
     n.sample_steps_m = steps_m;
-    n.sample_from_ns = r.snap_t_ns;
     n.log_w = r.log_w - 0.5 * (diff / kTurnAngleSigma_rad) * (diff / kTurnAngleSigma_rad) -
               0.5 * (snap_m / snap_sigma) * (snap_m / snap_sigma);
     advance(n, d_after_m, out);
   }
 }
 
-void RouteEngine::turn_candidates_ahead(const Route& r, double turn_rad, double d_after_m, TimeNs mid_ns,
+void RouteEngine::turn_candidates_ahead(const Route& r, double turn_rad, double d_after_m,
                                         std::vector<Route>& out) const {
   const WalkGraph& g = *graph_;
   struct Item { std::int32_t in_seg; double dist_m; int depth; };
@@ -247,7 +245,7 @@ void RouteEngine::turn_candidates_ahead(const Route& r, double turn_rad, double 
     work.pop_back();
     if (it.dist_m > opt_.distance_tolerance_m) continue;
     const auto& s = g.segment(it.in_seg);
-    branch_at(r, s.to, it.in_seg, turn_rad, d_after_m, it.dist_m, it.dist_m, mid_ns, out);
+    branch_at(r, s.to, it.in_seg, turn_rad, d_after_m, it.dist_m, it.dist_m, out);
     if (it.depth >= kAheadDepth) continue;
     for (const auto o : g.out_segments(s.to)) {
       if (!is_shallow(it.in_seg, o)) continue;
@@ -268,10 +266,10 @@ void RouteEngine::feed(const PdrTurn& turn) {
     if (t > mid) d_after += len;
   }
   const double turn_rad = turn.angle_rad;
-  std::vector<Route> next = apply_turn(turn_rad, d_after, mid);
+  std::vector<Route> next = apply_turn(turn_rad, d_after);
   if (next.empty() && local_restart()) {
     // Re-seeded around the last estimate: the turn just reported locates the walker.
-    next = apply_turn(turn_rad, d_after, mid);
+    next = apply_turn(turn_rad, d_after);
     if (next.empty()) return;  // keep the fresh routes; the next turn or fix prunes them
   }
   routes_.swap(next);
@@ -287,8 +285,7 @@ void RouteEngine::publish_scale_sample(TimeNs t_ns) {
   if (routes_.empty() || clusters_.empty()) return;
   if (clusters_.size() > 1 && clusters_[1].weight > opt_.ambiguity_ratio * clusters_[0].weight) return;
   const double r2 = opt_.cluster_radius_m * opt_.cluster_radius_m;
-  double w_all = 0.0, w_s = 0.0, wg = 0.0, wd = 0.0, w_best = -1.0;
-  TimeNs from_ns = 0;
+  double w_all = 0.0, w_s = 0.0, wg = 0.0, wd = 0.0;
   for (const Route& r : routes_) {
     if ((position(r) - clusters_.front().mean_en_m).squaredNorm() > r2) continue;
     const double w = std::exp(rank(r));
@@ -297,32 +294,29 @@ void RouteEngine::publish_scale_sample(TimeNs t_ns) {
     w_s += w;
     wg += w * r.sample_path_m;
     wd += w * r.sample_steps_m;
-    if (w > w_best) w_best = w, from_ns = r.sample_from_ns;
   }
   // most of the leading cluster must have come from a matched turn (not a fix or a restart)
   if (!(w_s > 0.5 * w_all) || !(wd > 0.0)) return;
   const double g = wg / w_s, d = wd / w_s;
-  // the ends' along-track error; the steps' stated length sigma is not added: it is mostly the
-  // scale error being measured, not noise of the sum
-  const double var_g = 2.0 * opt_.turn_position_sigma_m * opt_.turn_position_sigma_m;
   RouteScaleSample s;
-  s.from_ns = from_ns;
   s.t_ns = t_ns;
   s.scale = g / d;
-  s.sigma = std::hypot(std::sqrt(var_g) / d, opt_.path_length_sigma);
+  // the two ends' along-track error and the walked path against the polyline; the steps' stated
+  // length sigma is not added: it is mostly the scale error being measured, not noise of the sum
+  s.sigma = std::hypot(std::sqrt(2.0) * opt_.turn_position_sigma_m / d, opt_.path_length_sigma);
   s.distance_m = d;
   scale_sample_ = s;
 }
 
-std::vector<RouteEngine::Route> RouteEngine::apply_turn(double turn_rad, double d_after, TimeNs mid_ns) const {
+std::vector<RouteEngine::Route> RouteEngine::apply_turn(double turn_rad, double d_after) const {
   std::vector<Route> next;
   for (const auto& r : routes_) {
     for (std::uint8_t i = 0; i < r.n_passed; ++i) {
       const double back_m = r.odo_m - r.passed[i].odo_m;
       if (back_m > opt_.distance_tolerance_m) continue;
-      branch_at(r, r.passed[i].node, r.passed[i].in_seg, turn_rad, d_after, back_m, -back_m, mid_ns, next);
+      branch_at(r, r.passed[i].node, r.passed[i].in_seg, turn_rad, d_after, back_m, -back_m, next);
     }
-    turn_candidates_ahead(r, turn_rad, d_after, mid_ns, next);
+    turn_candidates_ahead(r, turn_rad, d_after, next);
   }
   return next;
 }

@@ -61,8 +61,7 @@ struct RouteOptions {
 
 /// A step-scale sample from two matched turns (RouteOptions::scale_sample_min_m).
 struct RouteScaleSample {
-  TimeNs from_ns = 0;        // the middle of the first turn
-  TimeNs t_ns = 0;           // ... of the second
+  TimeNs t_ns = 0;           // the middle of the second turn
   double scale = 1.0;        // path length along the graph / distance of the fed steps
   double sigma = 0.0;        // 1-sigma of `scale`
   double distance_m = 0.0;   // distance of the fed steps between the two turns
@@ -121,9 +120,7 @@ class RouteEngine {
     double log_w = 0.0;        // ranking log-likelihood (heading, fix distance)
     double turn_free_until_m = -1.0;  // odometer up to which a matched turn's bends are free
     double snap_odo_m = -1.0;  // odometer at the last matched turn's node (< 0: none since the route began)
-    TimeNs snap_t_ns = 0;      // ... the middle of that turn
     double sample_path_m = -1.0, sample_steps_m = 0.0;  // G and D at that turn (G < 0: none)
-    TimeNs sample_from_ns = 0;
     std::array<Passed, 4> passed{};
     std::uint8_t n_passed = 0;
   };
@@ -138,14 +135,14 @@ class RouteEngine {
   void initialise(const Eigen::Vector2d& p_en_m, double sigma_m, double radius_m);
   void advance(Route r, double d_m, std::vector<Route>& out) const;
   void branch_at(const Route& r, std::int32_t node, std::int32_t in_seg, double turn_rad,
-                 double d_after_m, double snap_m, double along_m, TimeNs mid_ns, std::vector<Route>& out) const;
+                 double d_after_m, double snap_m, double along_m, std::vector<Route>& out) const;
   void publish_scale_sample(TimeNs t_ns);
-  void turn_candidates_ahead(const Route& r, double turn_rad, double d_after_m, TimeNs mid_ns, std::vector<Route>& out) const;
+  void turn_candidates_ahead(const Route& r, double turn_rad, double d_after_m, std::vector<Route>& out) const;
   double bend_rad(std::int32_t in_seg, std::int32_t out_seg) const;
   double tail_bend(std::int32_t seg) const;
   double map_turn_rad(std::int32_t in_seg, std::int32_t out_seg) const;
   bool is_shallow(std::int32_t in_seg, std::int32_t out_seg) const;
-  std::vector<Route> apply_turn(double turn_rad, double d_after_m, TimeNs mid_ns) const;
+  std::vector<Route> apply_turn(double turn_rad, double d_after_m) const;
   bool local_restart();
   void reseed_along_track(const Eigen::Vector2d& p_en_m, double sigma_m, double radius_m,
                           std::vector<Route>& kept) const;
