@@ -90,7 +90,7 @@ add_test(NAME pdr_cli_tyrex_convert
                  "${_pdr_tyrex}/Guillaume_Nexus5_NoDist_RunningPocket"
                  "${_pdr_tyrex}/Guillaume_Nexus5_NoDist_Texting")
 set_tests_properties(pdr_cli_tyrex_convert PROPERTIES LABELS "pdr;cli" FIXTURES_SETUP pdr_tyrex
-                     PASS_REGULAR_EXPRESSION "carry running pocket +disturbance none +truth_steps +(29[0-9]|3[0-2][0-9]) cadence 2\\.[6-8][0-9] Hz.*carry texting +disturbance none +truth_steps +(8[5-9]|9[0-9]|10[0-9]) cadence 1\\.[0-2][0-9] Hz truth_lines [0-9]+ steps_span [3-9]\\.[0-9]-12[0-9]\\.[0-9] s of [0-9.]+-[0-9.]+ s.*converted 2 of 2 recordings")
+                     PASS_REGULAR_EXPRESSION "carry running pocket +disturbance none +truth_steps +(29[0-9]|3[0-2][0-9]) \\(periodic windows alone +(29[0-9]|3[0-2][0-9])\\) cadence 2\\.[6-8][0-9] Hz.*carry texting +disturbance none +truth_steps +(9[5-9]|1[01][0-9]) \\(periodic windows alone +(8[5-9]|9[0-9]|10[0-9])\\) cadence 1\\.[0-2][0-9] Hz truth_lines [0-9]+ steps_span [3-9]\\.[0-9]-12[0-9]\\.[0-9] s of [0-9.]+-[0-9.]+ s.*converted 2 of 2 recordings")
 add_test(NAME pdr_cli_eval_pdr_all
          COMMAND /usr/bin/python3 "${PROJECT_SOURCE_DIR}/tools/eval-pdr-all" --sets tyrex,oxford,outdoor --no-convert
                  --out "${_pdr_tyrex_out}" --pdnav $<TARGET_FILE:pdnav> --data "${PDNAV_SHARED_DATA_DIR}")
