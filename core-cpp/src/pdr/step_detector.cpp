@@ -88,7 +88,7 @@ void StepDetector::reset() {
   last_defined_ = Symbol::kUndefined;
   period_max_ = period_min_ = 0.0;
   have_step_ = false;
-  typical_interval_s_ = 0.0;
+  typical_interval_s_ = typical_before_s_ = 0.0;
   history_.clear();
   prev_stride_like_ = false;
 }
@@ -158,6 +158,7 @@ std::optional<StepCandidate> StepDetector::on_symbol(Symbol sym, TimeNs t_ns, do
   const double refractory = std::max(opt_.min_step_interval_s, opt_.refractory_fraction * typical_interval_s_);
   if (have_step_ && interval < refractory) return std::nullopt;
   if (swing < opt_.min_swing_mps2) return std::nullopt;
+  typical_before_s_ = typical_interval_s_;
   if (have_step_ && interval <= opt_.max_step_interval_s) {
     // Running average of the step interval (time constant ~8 steps) for the adaptive refractory.
     constexpr double kGain = 0.125;
@@ -174,7 +175,8 @@ std::optional<StepCandidate> StepDetector::on_symbol(Symbol sym, TimeNs t_ns, do
   return c;
 }
 
-bool StepDetector::stride_like(TimeNs t_ns, double interval_s) const {
+bool StepDetector::stride_like(TimeNs t_ns, double interval_s, bool* by_gyro) const {
+  if (by_gyro) *by_gyro = false;
   const double min_interval_s = running_ ? opt_.running_stride_min_interval_s : opt_.stride_min_interval_s;
   if (opt_.stride_harmonic_ratio <= 0.0 || interval_s < min_interval_s ||
       interval_s > opt_.stride_max_interval_s) {
@@ -202,7 +204,10 @@ bool StepDetector::stride_like(TimeNs t_ns, double interval_s) const {
   const double a1 = std::abs(x1);
   const double step_power = a1 > 0.0 ? std::abs(x2) / a1 : 0.0;
   if (step_power <= opt_.stride_harmonic_ratio) return false;
-  if (const std::optional<bool> rotates = rotates_at(t_ns, interval_s)) return *rotates;
+  if (const std::optional<bool> rotates = rotates_at(t_ns, interval_s)) {
+    if (by_gyro) *by_gyro = true;
+    return *rotates;
+  }
   // No gyroscope over the intervals: the tilt (rad, small-angle).
   const SwingAmplitudes tilt = swing_amplitudes(history_, from, t_ns, interval_s, [](const Tilted& h) { return h.dir; });
   return tilt.at_interval > opt_.stride_min_tilt_rad && tilt.at_interval > tilt.at_half;
@@ -235,13 +240,22 @@ void StepDetector::feed(const GyroSample& s) {
 }
 
 void StepDetector::split_strides(const StepCandidate& c, std::vector<StepCandidate>& out) {
-  const bool like = stride_like(c.t_ns, c.interval_s);
-  // Walking: two in a row (one odd long interval may be a pause). Running: one is enough.
-  const bool split = like && (prev_stride_like_ || (running_ && opt_.running_single_stride));
+  bool by_gyro = false;
+  const bool like = stride_like(c.t_ns, c.interval_s, &by_gyro);
+  // Walking: two in a row (one odd long interval may be a pause), or one of twice the bout's
+  // cadence whose swing the gyroscope saw. Running: one is enough.
+  const double tol = opt_.walking_single_stride_tol;
+  const bool two_steps_of_the_bout = tol > 0.0 && by_gyro && typical_before_s_ > 0.0 &&
+                                     std::abs(c.interval_s / (2.0 * typical_before_s_) - 1.0) <= tol;
+  const bool split = like && (prev_stride_like_ || (running_ && opt_.running_single_stride) || two_steps_of_the_bout);
   prev_stride_like_ = like;
   if (!split) {
     out.push_back(c);
     return;
+  }
+  if (typical_before_s_ > 0.0) {  // the cadence goes on at the half interval (it is two steps)
+    constexpr double kGain = 0.125;
+    typical_interval_s_ = typical_before_s_ + kGain * (0.5 * c.interval_s - typical_before_s_);
   }
   StepCandidate mid = c;
   mid.t_ns = c.t_ns - s_to_ns(0.5 * c.interval_s);

@@ -85,6 +85,14 @@ struct StepDetectorOptions {
   // missed. TYREX runs (issue 27), steps against the capture: hand -14.4 -> -7.0 %, pocket
   // -14.5 -> -8.4 %; walking unchanged.
   bool running_single_stride = true;
+  // ... and, walking, one stride-like interval of 2 steps of the bout's own cadence: an
+  // interval within [1 - tol, 1 + tol] x twice the running step interval, whose |a| carries
+  // the step frequency and whose phone swings at 1/I (the tests above), holds a step the level
+  // crossings missed (a swinging arm's weak heel strike); a pause shows no step power. The
+  // cadence is the one the bout kept up to it (step-to-step regularity: Moe-Nilssen &
+  // Helbostad 2004). Only with the swing read from the gyroscope: the tilt test passes a flat
+  // phone's sway (texting, below). 0 = off.
+  double walking_single_stride_tol = 0.2;
   double stride_max_interval_s = 2.6;   // longest stride (cadence >= 0.77 steps/s)
   double stride_harmonic_ratio = 0.1;   // |X(2/I)| / |X(1/I)| of |a| above this = step power present
   // The phone must also swing at 1/I: its tilt (direction of the low-passed specific force)
@@ -244,7 +252,8 @@ class StepDetector {
   Symbol quantise(double value) const;
   std::optional<StepCandidate> on_symbol(Symbol sym, TimeNs t_ns, double value);
   void split_strides(const StepCandidate& c, std::vector<StepCandidate>& out);
-  bool stride_like(TimeNs t_ns, double interval_s) const;
+  /// by_gyro (optional): set true when the swing was read from the gyroscope, not the tilt.
+  bool stride_like(TimeNs t_ns, double interval_s, bool* by_gyro = nullptr) const;
   /// Whether the gyroscope shows the phone swinging at 1/I; nullopt when its samples do not
   /// cover the last two intervals (no gyroscope, a gap, or a batch not yet delivered).
   std::optional<bool> rotates_at(TimeNs t_ns, double interval_s) const;
@@ -266,6 +275,7 @@ class StepDetector {
   bool have_step_ = false;
   TimeNs last_step_ns_ = 0;
   double typical_interval_s_ = 0.0;  // running average of in-bout step intervals (0 = none yet)
+  double typical_before_s_ = 0.0;    // ... before the latest candidate updated it
   // stride recognition (swinging hand)
   std::deque<Tilted> history_;       // the last 2 * stride_max_interval_s
   Eigen::Vector3d lpv1_ = Eigen::Vector3d::Zero(), lpv2_ = Eigen::Vector3d::Zero();
