@@ -120,7 +120,9 @@ int run_replay(const ReplayArgs& a) {
         },
         s);
     for (const Estimate& e : nav.take_step_estimates()) rec.observe_estimate(e);  // a row per step
-    rec.observe_estimate(nav.estimate());
+    const Estimate shown = nav.estimate();
+    rec.observe_estimate(shown);
+    if (shown.valid() && rec.engines_due(shown.t_ns)) rec.observe_engines(shown.t_ns, nav.output(0).engines);
     progress.update(reader.progress());
   }
   nav.finish();  // a walk shorter than the bout gate is still reported
@@ -136,6 +138,7 @@ int run_replay(const ReplayArgs& a) {
   const std::filesystem::path out(a.out_dir);
   rec.write_track_csv((out / "track.csv").string());
   rec.write_geojson((out / "track.geojson").string());
+  rec.write_engines_csv((out / "engines.csv").string());
   nlohmann::json summary;
   summary["log"] = a.log;
   summary["format"] = std::string(io::format_name(reader.format()));
@@ -192,7 +195,7 @@ int run_replay(const ReplayArgs& a) {
   std::cout << "mode changes: " << nav.output(0).mode_change_count << " (summary.json fusion.mode_changes)\n";
   for (const auto& [eng, n] : rec.epochs_by_engine()) std::cout << "  " << eng << ": " << n << "\n";
   std::cout << "run time: " << run_s << " s\n"
-            << "wrote:    " << (out / "track.csv").string() << ", track.geojson, summary.json\n";
+            << "wrote:    " << (out / "track.csv").string() << ", track.geojson, engines.csv, summary.json\n";
   if (st.n > 0) {
     std::cout << "reference: " << rec.reference_kind() << " (" << st.n << " epochs)\n";
     std::cout << "drms_m: " << st.drms_m << " rms_e_m: " << st.rms_e_m << " rms_n_m: " << st.rms_n_m

@@ -28,3 +28,14 @@ add_test(NAME fusion.compass_deviation_eth
           "$<TARGET_FILE:pdnav>" "${_fusion_eth}" "${_fusion_dev_out}" "${PROJECT_SOURCE_DIR}/tools/compass-deviation")
 set_tests_properties(fusion.compass_deviation_eth PROPERTIES LABELS "fusion;cli" TIMEOUT 120
                      PASS_REGULAR_EXPRESSION "deviation: compass_pieces=4[0-9] compass_octants=[78] compass_rms_A_deg=(1[89]|2[0-9])\\.[0-9]+ compass_rms_ABC_deg=[0-9]\\.[0-9]+ .* pdr_pieces=4[0-9] pdr_octants=[78] pdr_rms_A_deg=([0-9]|1[01])\\.[0-9]+ pdr_rms_ABC_deg=([0-9]|1[01])\\.[0-9]+ .* pdr_after_pieces=[34][0-9] pdr_after_octants=[5-8] pdr_after_rms_A_deg=([0-9]|1[01])\\.[0-9]+ ")
+
+# `pdnav replay`'s engines.csv: every running engine's own estimate once a second with its error
+# against the truth (which engine said what when the fused estimate moved; check_engines_csv.py).
+add_test(NAME fusion.replay_engines_csv
+  COMMAND /usr/bin/python3 "${CMAKE_CURRENT_SOURCE_DIR}/fusion/check_engines_csv.py" "$<TARGET_FILE:pdnav>"
+          "${PROJECT_BINARY_DIR}/test-scratch/terrain-cli/andorra_30m.pdem"
+          "${PROJECT_BINARY_DIR}/test-scratch/route-graph/andorra.graph"
+          "${PDNAV_SHARED_DATA_DIR}/gnss-gsdc2021-pixel5/hour1180.21n"
+          "${PROJECT_BINARY_DIR}/test-scratch/fusion-cli/engines-csv")
+set_tests_properties(fusion.replay_engines_csv PROPERTIES FIXTURES_REQUIRED "terrain_tile_andorra;route_andorra_graph"
+                     LABELS "fusion;cli" TIMEOUT 300 PASS_REGULAR_EXPRESSION "engines.csv checks passed")

@@ -204,6 +204,39 @@ void ReplayRecorder::write_track_csv(const std::string& path) const {
   }
 }
 
+void ReplayRecorder::observe_engines(TimeNs t_ns, const std::vector<Estimate>& engines) {
+  if (!engines_due(t_ns)) return;
+  last_engines_t_ = t_ns;
+  for (Estimate e : engines) {
+    if (!e.valid()) continue;
+    e.t_ns = t_ns;  // the epoch it was read at (an engine's own time may lag it)
+    engine_rows_.push_back(std::move(e));
+  }
+}
+
+void ReplayRecorder::write_engines_csv(const std::string& path) const {
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot create");
+  f << "t_ns,engine,status,lat_deg,lon_deg,cov_ee_m2,cov_en_m2,cov_nn_m2,semi_major_m,ref_lat_deg,ref_lon_deg,err_e_m,"
+       "err_n_m,reason\n";
+  f << std::setprecision(12);
+  for (const Estimate& e : engine_rows_) {
+    f << e.t_ns << ',' << to_string(e.engine) << ',' << to_string(e.status) << ',' << e.position.lat_deg() << ','
+      << e.position.lon_deg() << ',' << e.cov_en_m2(0, 0) << ',' << e.cov_en_m2(0, 1) << ',' << e.cov_en_m2(1, 1) << ','
+      << e.ellipse().semi_major_m << ',';
+    geo::Geodetic ref;
+    if (reference_at(e.t_ns, &ref)) {
+      const geo::Enu d = geo::LocalFrame(ref).to_enu(e.position);
+      f << ref.lat_deg() << ',' << ref.lon_deg() << ',' << d.e_m() << ',' << d.n_m();
+    } else {
+      f << ",,,";
+    }
+    std::string reason = e.reason;
+    std::replace(reason.begin(), reason.end(), ',', ';');
+    f << ',' << reason << '\n';
+  }
+}
+
 void ReplayRecorder::set_mode_changes(std::vector<std::pair<TimeNs, std::string>> changes) {
   std::stable_sort(changes.begin(), changes.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   mode_changes_ = std::move(changes);

@@ -78,6 +78,14 @@ class ReplayRecorder {
   ErrorStats error_stats() const;
   std::string reference_kind() const;
   void write_track_csv(const std::string& path) const;
+  /// Every running engine's own estimate (NavigatorOutput::engines), kept at most once per
+  /// engine_interval_s of log time: which engine said what when the fused estimate moved.
+  void observe_engines(TimeNs t_ns, const std::vector<Estimate>& engines);
+  bool engines_due(TimeNs t_ns) const { return last_engines_t_ < 0 || t_ns >= last_engines_t_ + s_to_ns(kEngineIntervalS); }
+  static constexpr double kEngineIntervalS = 1.0;
+  /// engines.csv: t_ns, engine, status, position, covariance, semi-major, the reference and the
+  /// error against it (as in the track CSV), reason.
+  void write_engines_csv(const std::string& path) const;
   void write_geojson(const std::string& path, std::size_t max_ellipses = 400) const;
   /// Hand-overs of the fused estimate (time, "from -> to: reason"): the track CSV's last column
   /// (mode_change) carries each one on the first epoch at or after its time.
@@ -91,6 +99,8 @@ class ReplayRecorder {
   std::vector<Ref> truth_;
   std::vector<Ref> fixes_;
   std::vector<Epoch> epochs_;
+  std::vector<Estimate> engine_rows_;
+  TimeNs last_engines_t_ = -1;
   TimeNs last_t_ = -1;
   EstimateStatus last_status_ = EstimateStatus::kNotInitialized;
 };
