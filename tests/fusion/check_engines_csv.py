@@ -14,18 +14,13 @@ import csv
 import math
 import os
 import statistics
-import subprocess
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from check_eval_outage import run  # noqa: E402  (exits with the command's output on failure)
 
 HEADER = ("t_ns,engine,status,lat_deg,lon_deg,cov_ee_m2,cov_en_m2,cov_nn_m2,semi_major_m,ref_lat_deg,ref_lon_deg,"
           "err_e_m,err_n_m,reason")
-
-
-def run(cmd):
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.exit(f"FAIL: {' '.join(cmd)} exited {r.returncode}:\n{r.stdout}\n{r.stderr}")
-    return r
 
 
 def main(argv):
