@@ -10,7 +10,8 @@
                  (the layout of Broyles et al. 2018, Figs. 8-10)
   tools/plot.py fusion OUT_DIR [--title T] [--out DIR]
       fusion.png  a fused replay: the track coloured by the engine shown, and the horizontal
-                  error and predicted 1-sigma vs time with every span without GNSS shaded
+                  error and predicted 1-sigma vs time with every span without GNSS shaded;
+                  with the replay's engines.csv, a third panel: each engine's own error
   tools/plot.py outage DIR [--title T] [--out DIR]
       <walk>_outage.png for every <walk>.csv of `pdnav eval-outage --out DIR` (and
       outage_summary.png when there are several walks or --start-fracs windows): the reference
@@ -266,7 +267,13 @@ def plot_fusion(args):
     eng = [r["engine"] for r in rows]
     if not np.isfinite(err).any():
         sys.exit(f"plot: {args.dir}/track.csv has no reference (Truth lines or phone fixes): nothing to score")
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(9, 10), gridspec_kw={"height_ratios": [3, 2]})
+    # each engine's own estimate (replay's engines.csv), when the replay wrote one
+    eng_path = os.path.join(args.dir, "engines.csv")
+    eng_rows = read_csv(eng_path) if os.path.exists(eng_path) else []
+    if eng_rows:
+        fig, (ax1, ax2, ax3) = plt.subplots(3, 1, figsize=(9, 13), gridspec_kw={"height_ratios": [3, 2, 2]})
+    else:
+        fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(9, 10), gridspec_kw={"height_ratios": [3, 2]})
     for name in sorted(set(eng)):
         m = np.array([x == name for x in eng])
         ax1.plot(e[m], n[m], ".", ms=2, color=ENGINE_COLOURS.get(name, "tab:gray"), label=f"shown: {name}")
@@ -290,6 +297,24 @@ def plot_fusion(args):
     ax2.set_xlabel("time (s); grey = GNSS not shown")
     ax2.set_ylabel("m")
     ax2.legend(loc="upper left", fontsize=8)
+    if eng_rows:
+        # which engine said what: each engine's own error (engines.csv, once a second) beside the shown one
+        te = (col(eng_rows, "t_ns") - float(rows[0]["t_ns"])) * 1e-9
+        ee = np.hypot(col(eng_rows, "err_e_m"), col(eng_rows, "err_n_m"))
+        names = [r["engine"] for r in eng_rows]
+        for name in sorted(set(names)):
+            m = np.array([x == name for x in names]) & np.isfinite(ee)
+            if m.any():
+                tt, yy = te[m], np.maximum(ee[m], 0.1)
+                gap = np.where(np.diff(tt) > 3.0)[0] + 1  # no valid estimate in between: no line
+                tt, yy = np.insert(tt, gap, np.nan), np.insert(yy, gap, np.nan)
+                ax3.plot(tt, yy, "-", lw=0.9, color=ENGINE_COLOURS.get(name, "tab:gray"),
+                         label=f"{name} engine on its own")
+        ax3.plot(t, np.maximum(err, 0.1), "k-", lw=0.8, label="shown (fused)")
+        ax3.set_yscale("log")
+        ax3.set_xlabel("time (s)")
+        ax3.set_ylabel("horizontal error (m)")
+        ax3.legend(loc="upper left", fontsize=8)
     fig.tight_layout()
     out = args.out or args.dir
     os.makedirs(out, exist_ok=True)

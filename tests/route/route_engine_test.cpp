@@ -198,6 +198,32 @@ TEST(RouteEngine, LocalRestartReseedsAroundTheLastEstimate) {
   EXPECT_NE(e.estimate().status, EstimateStatus::kLost);
 }
 
+TEST(RouteEngine, ALostEngineRetriesTheLocalRestartAsItWalks) {
+  // A fix (or the fused estimate it is re-anchored to) 60 m north of the east arm, with no way
+  // within its radius: no route, kLost. Before, a lost engine waited for the next fix however
+  // near a way it walked; now it retries the local restart every lost_retry_m walked.
+  auto g = crossing();
+  RouteEngine e(RouteOptions{}, g, 1);
+  e.feed(fix_at(*g, {100, 60}, 4.0, kNsPerS));  // radius 2.5 x 4 = 10 m: nothing within it
+  ASSERT_EQ(e.route_count(), 0u);
+  EXPECT_EQ(e.estimate().status, EstimateStatus::kLost);
+  TimeNs t = walk(e, kNsPerS, 20, 0.7, 90.0);  // 14 m east, still 60 m from the arm: nothing to find
+  EXPECT_EQ(e.route_count(), 0u);
+  EXPECT_EQ(e.local_restarts(), 0u);  // attempts without a way in reach are not restarts
+  t = walk(e, t, 60, 0.7, 180.0);  // 42 m south: within 30 m of the east arm after ~30 m
+  EXPECT_EQ(e.local_restarts(), 1u);
+  ASSERT_GT(e.route_count(), 0u);
+  EXPECT_NE(e.estimate().status, EstimateStatus::kLost);
+  for (const auto& c : e.candidates(1000)) EXPECT_LE(std::abs(c.en_m.y()), 1e-6);  // on the east arm
+  RouteOptions apt = RouteOptions{};
+  apt.lost_retry_m = 0.0;  // off: lost until the next fix
+  RouteEngine f(apt, g, 1);
+  f.feed(fix_at(*g, {100, 60}, 4.0, kNsPerS));
+  t = walk(f, kNsPerS, 20, 0.7, 90.0);
+  walk(f, t, 60, 0.7, 180.0);
+  EXPECT_EQ(f.route_count(), 0u);
+}
+
 TEST(RouteEngine, DeadEndOvershootDiesAtTheDistanceTolerance) {
   std::vector<Eigen::Vector2d> v{{0, 0}, {50, 0}};
   auto g = std::make_shared<const WalkGraph>(WalkGraph::build(kOrigin, v, {edge(0, 1)}));

@@ -168,11 +168,18 @@ void RouteEngine::feed(const PdrStep& step) {
     recent_steps_.pop_front();
   }
   if (!initialised_) return;
-  if (routes_.empty()) {  // lost: dead reckoning until the next fix
+  if (routes_.empty()) {  // lost: dead reckoning, and a local restart every lost_retry_m walked
     last_en_m_ += step.length_m * Eigen::Vector2d(std::sin(step.heading_rad), std::cos(step.heading_rad));
     last_cov_ += Eigen::Matrix2d::Identity() * (0.1 * step.length_m) * (0.1 * step.length_m);
+    lost_walked_m_ += step.length_m;
+    if (opt_.lost_retry_m > 0.0 && lost_walked_m_ >= opt_.lost_retry_m) {
+      lost_walked_m_ = 0.0;
+      const Eigen::Matrix2d cov = last_cov_;
+      if (!local_restart()) last_cov_ = cov;  // nothing within reach: keep the dead-reckoning sigma
+    }
     return;
   }
+  lost_walked_m_ = 0.0;
   std::vector<Route> next;
   next.reserve(routes_.size() + 16);
   for (const auto& r : routes_) advance(r, step.length_m, next);
@@ -198,8 +205,8 @@ void RouteEngine::feed(const PdrStep& step) {
 // around the last estimate with local_restart_radius_m; GNSS fixes are minutes apart.
 bool RouteEngine::local_restart() {
   if (!(opt_.local_restart_radius_m > 0.0)) return false;
-  ++local_restarts_;
   initialise(last_en_m_, opt_.local_restart_radius_m / opt_.init_radius_sigmas, opt_.local_restart_radius_m);
+  if (!routes_.empty()) ++local_restarts_;  // an attempt with no way within reach is not a restart
   return !routes_.empty();
 }
 

@@ -31,6 +31,9 @@ struct RouteOptions {
   /// Every route died: re-seed within this radius of the last estimate instead of waiting
   /// minutes for the next fix (0 = APT behaviour: lost until the next fix).
   double local_restart_radius_m = 30.0;
+  /// ... and while lost (no route near a fix or a re-anchoring position), retry that restart
+  /// every this many metres walked (a third of the radius: no way is walked past unseen).
+  double lost_retry_m = 10.0;
   double init_radius_sigmas = 2.5;   // initial routes within k * fix sigma (2.5 -> 99.8 % in 2D)
   double init_spacing_m = 2.0;       // spacing of initial route positions along each segment
   double min_fix_sigma_m = 3.0;      // floor on a fix's reported 1-sigma radius
@@ -158,6 +161,7 @@ class RouteEngine {
   std::vector<Cluster> clusters_;
   std::deque<std::pair<TimeNs, double>> recent_steps_;  // (t, length) for turn snapping
   bool truncated_ = false;
+  double lost_walked_m_ = 0.0;     // walked while lost since the last local restart attempt
   double step_scale_sigma_ = 0.0;  // set_step_scale_sigma (<= 0: kStepScaleSigma)
   std::optional<RouteScaleSample> scale_sample_;
   bool initialised_ = false;
