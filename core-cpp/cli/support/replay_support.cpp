@@ -13,6 +13,13 @@
 #include <Eigen/LU>
 
 namespace pdnav::cli {
+namespace {
+/// Free text in one CSV field: its commas become semicolons (the files are not quoted).
+std::string csv_text(std::string s) {
+  std::replace(s.begin(), s.end(), ',', ';');
+  return s;
+}
+}  // namespace
 
 std::vector<double> parse_number_list(const std::string& text, const std::string& what) {
   std::vector<double> out;
@@ -198,9 +205,7 @@ void ReplayRecorder::write_track_csv(const std::string& path) const {
       f << ep.ref.lat_deg() << ',' << ep.ref.lon_deg() << ',' << ep.err_e_m << ',' << ep.err_n_m;
     else
       f << ",,,";
-    std::string reason = e.reason;
-    std::replace(reason.begin(), reason.end(), ',', ';');
-    f << ',' << reason << ',' << mode_changes_up_to(e.t_ns, &next_change) << '\n';
+    f << ',' << csv_text(e.reason) << ',' << mode_changes_up_to(e.t_ns, &next_change) << '\n';
   }
 }
 
@@ -231,9 +236,7 @@ void ReplayRecorder::write_engines_csv(const std::string& path) const {
     } else {
       f << ",,,";
     }
-    std::string reason = e.reason;
-    std::replace(reason.begin(), reason.end(), ',', ';');
-    f << ',' << reason << '\n';
+    f << ',' << csv_text(e.reason) << '\n';
   }
 }
 
@@ -248,8 +251,7 @@ std::string ReplayRecorder::mode_changes_up_to(TimeNs t_ns, std::size_t* next) c
     if (!out.empty()) out += " | ";
     out += mode_changes_[*next].second;
   }
-  std::replace(out.begin(), out.end(), ',', ';');
-  return out;
+  return csv_text(std::move(out));
 }
 
 std::vector<std::pair<double, double>> ellipse_polygon(const Estimate& e, double k, int points) {

@@ -79,7 +79,7 @@ class ReplayRecorder {
   std::string reference_kind() const;
   void write_track_csv(const std::string& path) const;
   /// Every running engine's own estimate (NavigatorOutput::engines), kept at most once per
-  /// engine_interval_s of log time: which engine said what when the fused estimate moved.
+  /// kEngineIntervalS of log time: which engine said what when the fused estimate moved.
   void observe_engines(TimeNs t_ns, const std::vector<Estimate>& engines);
   bool engines_due(TimeNs t_ns) const { return last_engines_t_ < 0 || t_ns >= last_engines_t_ + s_to_ns(kEngineIntervalS); }
   static constexpr double kEngineIntervalS = 1.0;

@@ -9,6 +9,9 @@ namespace pdnav::pdr {
 
 namespace {
 
+/// Gain of the running average of the in-bout step interval (time constant ~8 steps).
+constexpr double kIntervalGain = 0.125;
+
 /// How much a 3-vector series (the phone's tilt, or its angular rate) swings at 1/I and at
 /// 1/(2I) over the samples in [from, to]: single-bin DFTs of the series less its mean, as
 /// amplitudes 2|X|/n.
@@ -160,9 +163,8 @@ std::optional<StepCandidate> StepDetector::on_symbol(Symbol sym, TimeNs t_ns, do
   if (swing < opt_.min_swing_mps2) return std::nullopt;
   typical_before_s_ = typical_interval_s_;
   if (have_step_ && interval <= opt_.max_step_interval_s) {
-    // Running average of the step interval (time constant ~8 steps) for the adaptive refractory.
-    constexpr double kGain = 0.125;
-    typical_interval_s_ = typical_interval_s_ > 0.0 ? typical_interval_s_ + kGain * (interval - typical_interval_s_) : interval;
+    // Running average of the step interval for the adaptive refractory.
+    typical_interval_s_ = typical_interval_s_ > 0.0 ? typical_interval_s_ + kIntervalGain * (interval - typical_interval_s_) : interval;
   } else if (have_step_) {
     typical_interval_s_ = 0.0;  // a pause: forget the cadence
   }
@@ -253,10 +255,8 @@ void StepDetector::split_strides(const StepCandidate& c, std::vector<StepCandida
     out.push_back(c);
     return;
   }
-  if (typical_before_s_ > 0.0) {  // the cadence goes on at the half interval (it is two steps)
-    constexpr double kGain = 0.125;
-    typical_interval_s_ = typical_before_s_ + kGain * (0.5 * c.interval_s - typical_before_s_);
-  }
+  if (typical_before_s_ > 0.0)  // the cadence goes on at the half interval (it is two steps)
+    typical_interval_s_ = typical_before_s_ + kIntervalGain * (0.5 * c.interval_s - typical_before_s_);
   StepCandidate mid = c;
   mid.t_ns = c.t_ns - s_to_ns(0.5 * c.interval_s);
   mid.interval_s = 0.5 * c.interval_s;
