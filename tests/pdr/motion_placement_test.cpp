@@ -121,6 +121,49 @@ TEST(PdrMotion, StepsRightAfterWavingKeepTheWalksHeading) {
   }
 }
 
+TEST(PdrMotion, AWalkThatStartsAsTheWavingEndsKeepsItsFirstSteps) {
+  // The walker stops waving and walks at once: the classifier's hang-over (hold_s after the
+  // rotation stops turning like handling) covered the first 2-3 steps, which were refused. They
+  // now wait for the walk after them (PdrOptions::hangover_steps_wait) and count when the next
+  // step follows in the walk's rhythm, with its heading.
+  const RealWalk walk = read_ilc(pdnav::test::shared_data(kWalk));
+  const TimeNs start = walk.accel.front().t_ns;
+  PdrOptions o;
+  o.heading.mount = Mount::kAuto;
+  PdrOptions refused = o;
+  refused.hangover_steps_wait = false;
+  const auto alone = run(o, walk);
+  ASSERT_GT(alone.size(), 40u);
+  std::size_t kept_total = 0, refused_total = 0;
+  for (std::uint64_t seed : {1u, 2u, 3u, 4u}) {
+    const RealWalk waving = make_waving(walk, start - 20'000'000, 30.0, seed, seed <= 2 ? 1.0 : 0.5);
+    std::size_t kept = 0, before = 0, in_waving = 0;
+    double worst_deg = 0.0;
+    for (const auto& s : run(o, waving, &walk)) {
+      if (s.t_ns < start) {
+        ++in_waving;
+        continue;
+      }
+      ++kept;
+      for (const auto& a : alone)
+        if (std::abs(ns_to_s(a.t_ns - s.t_ns)) <= 0.03)
+          worst_deg = std::max(worst_deg, std::abs(rad_to_deg(wrap_pi(s.heading_rad - a.heading_rad))));
+    }
+    std::size_t in_waving_before = 0;
+    for (const auto& s : run(refused, waving, &walk)) (s.t_ns >= start ? before : in_waving_before) += 1;
+    std::printf("seed %llu: %zu steps after the waving (%zu with the hang-over's refused, %zu alone), %zu in it (%zu), "
+                "worst heading difference %.1f deg\n",
+                static_cast<unsigned long long>(seed), kept, before, alone.size(), in_waving, in_waving_before, worst_deg);
+    EXPECT_LE(in_waving, in_waving_before) << "seed " << seed;  // none added inside the waving
+    EXPECT_LE(alone.size(), kept + 1) << "seed " << seed;  // at most one of the walk's steps lost
+    EXPECT_LE(kept, alone.size()) << "seed " << seed;      // and none made up
+    EXPECT_LT(worst_deg, 25.0) << "seed " << seed;
+    kept_total += kept;
+    refused_total += before;
+  }
+  EXPECT_GE(kept_total, refused_total + 6);  // the hang-over held 2-3 of each walk's first steps
+}
+
 TEST(PdrHeadingFusion, TheFirstPlacementBoutKeepsTheOffsetLearnedBeforeIt) {
   // The placement estimator opens its first bout once it has 1 s of gravity; the heading offset
   // learned from the rotation vector until then refers to the same axis (+Y) and must survive:

@@ -190,23 +190,76 @@ void Pdr::feed(const AccelSample& s) {
   }
   latest_ns_ = std::max(latest_ns_, s.t_ns);
   release(gate_.expire(s.t_ns), s.t_ns);
+  // handling again, or no step followed (the next one, due within max_step_interval_s, is
+  // reported up to one more interval later): the hang-over's candidates were not a walk
+  if (!hangover_.empty() && (classifier_.handling_features() ||
+                             s.t_ns - hangover_.back().candidate.t_ns > 2 * s_to_ns(opt_.detector.max_step_interval_s)))
+    drop_hangover();
   for (const auto& c : candidates) {
     if (opt_.gate_handling && (handling || classifier_.handling_at(c.t_ns))) {
-      // a waved/handled phone: no step, and the bout must start again after it
+      // In the hang-over (the rotation no longer turns like handling, after the last window
+      // that did) the step waits for the walk after it; otherwise a waved/handled phone: no
+      // step, and the bout must start again after it.
+      const TimeNs last_features_ns = classifier_.handling_features_last_ns();
+      if (opt_.hangover_steps_wait && !classifier_.handling_features() && last_features_ns >= 0 &&
+          c.t_ns > last_features_ns) {
+        hangover_.push_back(hold(c));
+        continue;
+      }
+      drop_hangover();
       ++counters_.steps_discarded_by_motion;
       (void)gate_.end_bout();
       continue;
     }
+    HeldStep h = hold(c);
+    settle_hangover(h, s.t_ns);
     last_swing_mps2_ = c.swing_mps2;
     last_swing_ns_ = c.t_ns;
-    release(gate_.push(c.t_ns, hold(c)), s.t_ns);
+    release(gate_.push(c.t_ns, std::move(h)), s.t_ns);
   }
   trim_consistency(s.t_ns);
+}
+
+void Pdr::drop_hangover() {
+  counters_.steps_discarded_by_motion += static_cast<std::int64_t>(hangover_.size());
+  hangover_.clear();
+}
+
+void Pdr::settle_hangover(const HeldStep& next, TimeNs now_ns) {
+  if (hangover_.empty()) return;
+  // the rhythm: every interval from the first hang-over step to the next step a step's
+  const TimeNs lo = s_to_ns(opt_.detector.min_step_interval_s), hi = s_to_ns(opt_.detector.max_step_interval_s);
+  TimeNs prev = hangover_.front().candidate.t_ns;
+  bool rhythm = true;
+  for (std::size_t i = 1; i <= hangover_.size(); ++i) {
+    const TimeNs t = i < hangover_.size() ? hangover_[i].candidate.t_ns : next.candidate.t_ns;
+    rhythm = rhythm && t - prev >= lo && t - prev <= hi;
+    prev = t;
+  }
+  if (!rhythm) {
+    drop_hangover();
+    return;
+  }
+  std::vector<HeldStep> steps;
+  steps.swap(hangover_);
+  for (HeldStep& h : steps) {
+    // Taken while the heading offset restarted and the placement bout had ended (handling):
+    // the walk's direction is the next step's (a second or less later), turned back by the
+    // gyro's yaw about the vertical between the two steps (left positive).
+    const StepCandidate own = h.candidate;
+    const double turned_rad = next.vertical_yaw_rad - h.vertical_yaw_rad;
+    h = next;
+    h.candidate = own;
+    h.heading_rad = wrap_two_pi(next.heading_rad + turned_rad);
+    ++counters_.steps_from_handling_hangover;
+    release(gate_.push(own.t_ns, std::move(h)), now_ns);
+  }
 }
 
 Pdr::HeldStep Pdr::hold(const StepCandidate& c) const {
   HeldStep h;
   h.candidate = c;
+  h.vertical_yaw_rad = tracker_.yaw_rad();
   // The heading at the step's own time (issue 20.2): magnetic when referenced to the rotation
   // vector or compass (declination added when the step is taken), true when gyro-only from
   // the configured initial heading (heading_rad() adds the declination only in the first case).
@@ -360,6 +413,7 @@ void Pdr::release(const std::vector<HeldStep>& steps, TimeNs now_ns) {
 }
 
 void Pdr::finish() {
+  drop_hangover();  // no walk followed
   release(gate_.finish(), latest_ns_);
   settle_handling_wait(latest_ns_, true);
   settle_vehicle_wait(latest_ns_, true);

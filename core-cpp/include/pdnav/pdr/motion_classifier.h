@@ -158,6 +158,11 @@ class MotionClassifier {
   double gait_coherence() const { return gait_coherence_; }
   /// True when t_ns lies inside a handling span (closed, or the open one).
   bool handling_at(TimeNs t_ns) const;
+  /// The latest window turns like handling (the features themselves, without the hold_s
+  /// hang-over that keeps state() at kHandling after they drop).
+  bool handling_features() const { return handling_raw_; }
+  /// Time of the latest window whose features turned like handling (-1: none yet).
+  TimeNs handling_features_last_ns() const { return handling_last_ns_; }
   /// Handling spans so far (bounded to the last 256).
   const std::deque<MotionSpan>& handling_spans() const { return spans_; }
   /// The rotation looks like the start or end of handling (MotionClassifierOptions::suspect_fraction).

@@ -55,6 +55,13 @@ struct PdrOptions {
   PlacementOptions placement;    // placement + walking direction when heading.mount == kAuto
   MotionClassifierOptions motion;  // walking / standing / handling
   bool gate_handling = true;     // no steps while the phone is handled or waved
+  /// A step taken in handling's hang-over (MotionClassifierOptions::hold_s after the rotation
+  /// stopped looking like handling) waits for the walk after it: it counts when the next step
+  /// outside handling follows in the walk's rhythm (every interval within the detector's
+  /// min_step_interval_s .. max_step_interval_s), and is refused if handling resumes or no
+  /// step follows. A walker who starts walking as the compass-calibration wave ends used to
+  /// lose the first 2-3 steps (docs/pdr.md stage 1). false = every hang-over step refused.
+  bool hangover_steps_wait = true;
   bool gate_vehicle = true;      // no steps while riding (motion.vehicle must be on); steps
                                  // wait while vehicle evidence accumulates (docs/pdr.md)
   /// Bounded latency of that wait (issue 27): a step waits for the vehicle decision only while
@@ -96,6 +103,7 @@ struct PdrCounters {
   double vehicle_max_score_s = 0.0;
   double vehicle_kinematic_max_mps2 = 0.0;
   std::int64_t steps_added_at_stride_midpoints = 0;  // swinging hand / running strides split (stage 4)
+  std::int64_t steps_from_handling_hangover = 0;  // hang-over steps the walk after it kept (hangover_steps_wait)
   /// Steps emitted before the placement bout they belong to had begun (its walking direction
   /// was waited for max_direction_wait_s in vain): they carry the previous bout's direction.
   std::int64_t steps_before_their_bouts_direction = 0;
@@ -222,6 +230,7 @@ class Pdr {
     bool android = false;  // an Android step-detector event (emitted directly, no placement wait)
     bool handling_suspect = false;  // delivered while the rotation looked like handling starting
     HeadingSource source = HeadingSource::kInitial;
+    double vertical_yaw_rad = 0.0;  // the gyro's integrated yaw about the vertical at the step
   };
   HeldStep hold(const StepCandidate& c) const;
   void release(const std::vector<HeldStep>& steps, TimeNs now_ns);
@@ -290,6 +299,12 @@ class Pdr {
   MotionClassifier classifier_;
   std::deque<HeldStep> vehicle_wait_;
   std::deque<HeldStep> handling_wait_;
+  /// Steps of the handling hang-over waiting for the walk after it (hangover_steps_wait).
+  std::vector<HeldStep> hangover_;
+  void drop_hangover();
+  /// The next step outside handling: the hang-over steps count if their rhythm leads to it,
+  /// with its heading and walking direction.
+  void settle_hangover(const HeldStep& next, TimeNs now_ns);
   PlacementEstimator placement_;
   HeadingFusion fusion_;
   QuasiStaticField qsf_;
