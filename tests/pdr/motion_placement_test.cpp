@@ -164,6 +164,30 @@ TEST(PdrMotion, AWalkThatStartsAsTheWavingEndsKeepsItsFirstSteps) {
   EXPECT_GE(kept_total, refused_total + 6);  // the hang-over held 2-3 of each walk's first steps
 }
 
+TEST(PdrMotion, AHangOverWithNoWalkAfterItCountsNothing) {
+  // The same waving followed by only the walk's first second (the recording ends, or the
+  // walker stands): whatever the hang-over held has no step after it and is refused.
+  const RealWalk walk = read_ilc(pdnav::test::shared_data(kWalk));
+  const TimeNs start = walk.accel.front().t_ns;
+  RealWalk first_second;
+  for (const auto& a : walk.accel)
+    if (a.t_ns < start + 1'000'000'000) first_second.accel.push_back(a);
+  for (const auto& g : walk.gyro)
+    if (g.t_ns < start + 1'000'000'000) first_second.gyro.push_back(g);
+  for (const auto& r : walk.rotation)
+    if (r.t_ns < start + 1'000'000'000) first_second.rotation.push_back(r);
+  PdrOptions o;
+  o.heading.mount = Mount::kAuto;
+  PdrOptions refused = o;
+  refused.hangover_steps_wait = false;
+  for (std::uint64_t seed : {1u, 2u, 3u, 4u}) {
+    const RealWalk waving = make_waving(walk, start - 20'000'000, 30.0, seed, seed <= 2 ? 1.0 : 0.5);
+    const auto kept = run(o, waving, &first_second);
+    EXPECT_LE(kept.size(), run(refused, waving, &first_second).size()) << "seed " << seed;
+    for (const auto& s : kept) EXPECT_LT(s.t_ns, start) << "seed " << seed;  // none from the hang-over
+  }
+}
+
 TEST(PdrHeadingFusion, TheFirstPlacementBoutKeepsTheOffsetLearnedBeforeIt) {
   // The placement estimator opens its first bout once it has 1 s of gravity; the heading offset
   // learned from the rotation vector until then refers to the same axis (+Y) and must survive:
