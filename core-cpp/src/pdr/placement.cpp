@@ -212,13 +212,7 @@ void PlacementEstimator::update_forward() {
     if (trusted && vf > 0.0) c = prior.dot(corr_) / std::sqrt(var_v_ * vf);
     bout_.phase_corr = c;
     reversed_ = trusted && c < flip_threshold();
-    Eigen::Vector3d fwd = prior;
-    if (opt_.prior_square_to_x) {
-      const Eigen::Vector3d square = up_.cross(Eigen::Vector3d::UnitX());  // horizontal
-      if (square.norm() > 0.5)  // else X is near the vertical: the prior's own projection
-        fwd = square.dot(prior) >= 0.0 ? Eigen::Vector3d(square.normalized()) : Eigen::Vector3d(-square.normalized());
-    }
-    bout_.forward_phone = reversed_ ? Eigen::Vector3d(-fwd) : fwd;
+    bout_.forward_phone = reversed_ ? Eigen::Vector3d(-prior) : prior;
     return;
   }
   // other placements (and a rejected prior): the perpendicular of the dominant rotation axis

@@ -69,13 +69,6 @@ struct PlacementOptions {
   // this from the prior's line, after this much walking (halfway between the axes).
   double prior_max_angle_rad = 45 * kDegToRad;
   double prior_check_s = 4.0;
-  // The flat and upright priors point square to the phone's X axis (the screen's left-right):
-  // forward = up x X, horizontal. For a level phone that is +Y (flat) or -Z (upright), as the
-  // axes themselves; a phone held in front at a pitch p with a roll r (a hand never holds it
-  // level) has +Y's horizontal projection turned by about atan(sin r tan p), while the screen's
-  // left-right axis stays square to the line of sight and so to the walk. false = the axes'
-  // own projections (before issue 27's session 23).
-  bool prior_square_to_x = true;
   // Limb carries (trouser pocket, swinging hand): the gait turns the phone about the body's
   // medio-lateral axis (hip / shoulder flexion), a horizontal axis square to the walk. The
   // walking direction is then up x (the dominant axis of the levelled, gait-band angular rate),
