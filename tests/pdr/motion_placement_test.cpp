@@ -397,6 +397,34 @@ TEST(PdrMotion, AndroidStepEventsWhileWavingAreRefused) {
   }
 }
 
+TEST(PdrMotion, AndroidStepEventsOfAWalkThatStartsAsTheWavingEndsCount) {
+  // The phone's own step detector while walking on at once after the waving: its events in the
+  // hang-over wait for the next event (PdrOptions::hangover_steps_wait) as the accelerometer's
+  // steps do; refused, the first 2-3 of the walk were lost.
+  const RealWalk walk = read_ilc(pdnav::test::shared_data(kWalk));
+  const TimeNs start = walk.accel.front().t_ns;
+  const RealWalk waving = make_waving(walk, start - 20'000'000, 30.0, 1, 1.0);
+  RealWalk both = waving;  // the waving, then the walk
+  both.accel.insert(both.accel.end(), walk.accel.begin(), walk.accel.end());
+  both.gyro.insert(both.gyro.end(), walk.gyro.begin(), walk.gyro.end());
+  const TimeNs period = 550'000'000;  // the walk's own cadence, ~1.8 Hz
+  const std::size_t events = static_cast<std::size_t>((walk.accel.back().t_ns - start) / period) + 1;
+  PdrOptions o;
+  o.heading.mount = Mount::kAuto;
+  o.source = StepSource::kAndroid;
+  PdrOptions refused = o;
+  refused.hangover_steps_wait = false;
+  Pdr kept_pdr(o), refused_pdr(refused);
+  const std::size_t kept = test::feed_with_step_events(kept_pdr, both, start, period, true);
+  const std::size_t before = test::feed_with_step_events(refused_pdr, both, start, period, true);
+  std::printf("%zu events in the walk: %zu counted, %zu with the hang-over's refused\n", events, kept, before);
+  EXPECT_LE(events, kept + 1);  // at most one lost (the first, inside the last waving window)
+  EXPECT_LE(kept, events);
+  EXPECT_GE(kept, before + 2);
+  // counted: the events and the accelerometer's own candidates (kept for the consistency check)
+  EXPECT_GE(kept_pdr.counters().steps_from_handling_hangover, static_cast<std::int64_t>(kept - before));
+}
+
 TEST(PdrPlacement, APhoneOnItsSideDecidesItsDirectionAfterMinBoutWalking) {
   // The real walk with the phone on its side (gravity along +X: placement "other", no prior
   // axis). Its walking direction is the lagged correlation vector, trusted after min_bout_s of

@@ -195,6 +195,9 @@ void Pdr::feed(const AccelSample& s) {
   if (!hangover_.empty() && (classifier_.handling_features() ||
                              s.t_ns - hangover_.back().candidate.t_ns > 2 * s_to_ns(opt_.detector.max_step_interval_s)))
     drop_hangover();
+  if (!android_hangover_.empty() && (classifier_.handling_features() ||
+                                     s.t_ns - android_hangover_.back().first > 2 * s_to_ns(opt_.detector.max_step_interval_s)))
+    drop_android_hangover();
   for (const auto& c : candidates) {
     if (opt_.gate_handling && (handling || classifier_.handling_at(c.t_ns))) {
       // In the hang-over (the rotation no longer turns like handling, after the last window
@@ -414,6 +417,7 @@ void Pdr::release(const std::vector<HeldStep>& steps, TimeNs now_ns) {
 
 void Pdr::finish() {
   drop_hangover();  // no walk followed
+  drop_android_hangover();
   release(gate_.finish(), latest_ns_);
   settle_handling_wait(latest_ns_, true);
   settle_vehicle_wait(latest_ns_, true);
@@ -517,7 +521,16 @@ void Pdr::feed(const StepDetectorSample& s) {
   have_android_ = true;
   last_android_ns_ = s.t_ns;
   if (opt_.gate_handling && (classifier_.state() == MotionState::kHandling || classifier_.handling_at(s.t_ns))) {
-    ++counters_.steps_discarded_by_motion;  // the phone's own detector counts waving too
+    // in the hang-over the event waits for the walk after it, as the accelerometer's steps do
+    const TimeNs last_features_ns = classifier_.handling_features_last_ns();
+    if (opt_.hangover_steps_wait && !classifier_.handling_features() && last_features_ns >= 0 &&
+        s.t_ns > last_features_ns) {
+      android_hangover_.emplace_back(s.t_ns, tracker_.yaw_rad());
+    } else {
+      drop_android_hangover();
+      ++counters_.steps_discarded_by_motion;  // the phone's own detector counts waving too
+    }
+    trim_consistency(s.t_ns);
     return;
   }
   if (opt_.gate_vehicle && classifier_.in_vehicle()) {
@@ -533,14 +546,40 @@ void Pdr::feed(const StepDetectorSample& s) {
     event.interval_s = 0.0;  // unknown: the length model's cadence fallback
     HeldStep h = hold(event);
     h.android = true;
-    if (vehicle_gated() || !vehicle_wait_.empty()) {
-      vehicle_wait_.push_back(h);
-      settle_vehicle_wait(s.t_ns, false);
-    } else {
-      emit_step(h);
+    const auto emit_android = [&](const HeldStep& x) {
+      if (vehicle_gated() || !vehicle_wait_.empty()) {
+        vehicle_wait_.push_back(x);
+        settle_vehicle_wait(s.t_ns, false);
+      } else {
+        emit_step(x);
+      }
+    };
+    // the hang-over's events count when this one follows in their rhythm (settle_hangover)
+    if (!android_hangover_.empty()) {
+      const TimeNs lo = s_to_ns(opt_.detector.min_step_interval_s), hi = s_to_ns(opt_.detector.max_step_interval_s);
+      bool rhythm = true;
+      for (std::size_t i = 0; i < android_hangover_.size(); ++i) {
+        const TimeNs t = i + 1 < android_hangover_.size() ? android_hangover_[i + 1].first : s.t_ns;
+        rhythm = rhythm && t - android_hangover_[i].first >= lo && t - android_hangover_[i].first <= hi;
+      }
+      if (!rhythm) drop_android_hangover();
+      for (const auto& [t_ns, vertical_yaw_rad] : android_hangover_) {
+        HeldStep x = h;
+        x.candidate.t_ns = t_ns;
+        x.heading_rad = wrap_two_pi(h.heading_rad + (h.vertical_yaw_rad - vertical_yaw_rad));
+        ++counters_.steps_from_handling_hangover;
+        emit_android(x);
+      }
+      android_hangover_.clear();
     }
+    emit_android(h);
   }
   trim_consistency(s.t_ns);
+}
+
+void Pdr::drop_android_hangover() {
+  counters_.steps_discarded_by_motion += static_cast<std::int64_t>(android_hangover_.size());
+  android_hangover_.clear();
 }
 
 bool Pdr::android_active(TimeNs t_ns) const {

@@ -6,6 +6,7 @@
 #include <deque>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pdnav/geo/events.h"
@@ -59,8 +60,9 @@ struct PdrOptions {
   /// stopped looking like handling) waits for the walk after it: it counts when the next step
   /// outside handling follows in the walk's rhythm (every interval within the detector's
   /// min_step_interval_s .. max_step_interval_s), and is refused if handling resumes or no
-  /// step follows. A walker who starts walking as the compass-calibration wave ends used to
-  /// lose the first 2-3 steps (docs/pdr.md stage 1). false = every hang-over step refused.
+  /// step follows (an Android step event likewise waits for the next event). A walker who
+  /// starts walking as the compass-calibration wave ends used to lose the first 2-3 steps
+  /// (docs/pdr.md stage 1). false = every hang-over step refused.
   bool hangover_steps_wait = true;
   bool gate_vehicle = true;      // no steps while riding (motion.vehicle must be on); steps
                                  // wait while vehicle evidence accumulates (docs/pdr.md)
@@ -103,7 +105,7 @@ struct PdrCounters {
   double vehicle_max_score_s = 0.0;
   double vehicle_kinematic_max_mps2 = 0.0;
   std::int64_t steps_added_at_stride_midpoints = 0;  // swinging hand / running strides split (stage 4)
-  std::int64_t steps_from_handling_hangover = 0;  // hang-over steps the walk after it kept (hangover_steps_wait)
+  std::int64_t steps_from_handling_hangover = 0;  // hang-over candidates and Android events the walk after them kept (hangover_steps_wait)
   /// Steps emitted before the placement bout they belong to had begun (its walking direction
   /// was waited for max_direction_wait_s in vain): they carry the previous bout's direction.
   std::int64_t steps_before_their_bouts_direction = 0;
@@ -302,6 +304,9 @@ class Pdr {
   /// Steps of the handling hang-over waiting for the walk after it (hangover_steps_wait).
   std::vector<HeldStep> hangover_;
   void drop_hangover();
+  /// The same for Android step events: (time, the gyro's vertical yaw then).
+  std::vector<std::pair<TimeNs, double>> android_hangover_;
+  void drop_android_hangover();
   /// The next step outside handling: the hang-over steps count if their rhythm leads to it,
   /// with its heading and walking direction.
   void settle_hangover(const HeldStep& next, TimeNs now_ns);
