@@ -190,22 +190,13 @@ void Pdr::feed(const AccelSample& s) {
   }
   latest_ns_ = std::max(latest_ns_, s.t_ns);
   release(gate_.expire(s.t_ns), s.t_ns);
-  // handling again, or no step followed (the next one, due within max_step_interval_s, is
-  // reported up to one more interval later): the hang-over's candidates were not a walk
-  if (!hangover_.empty() && (classifier_.handling_features() ||
-                             s.t_ns - hangover_.back().candidate.t_ns > 2 * s_to_ns(opt_.detector.max_step_interval_s)))
-    drop_hangover();
-  if (!android_hangover_.empty() && (classifier_.handling_features() ||
-                                     s.t_ns - android_hangover_.back().first > 2 * s_to_ns(opt_.detector.max_step_interval_s)))
-    drop_android_hangover();
+  if (!hangover_.empty() && hangover_expired(hangover_.back().candidate.t_ns, s.t_ns)) drop_hangover();
+  if (!android_hangover_.empty() && hangover_expired(android_hangover_.back().first, s.t_ns)) drop_android_hangover();
   for (const auto& c : candidates) {
     if (opt_.gate_handling && (handling || classifier_.handling_at(c.t_ns))) {
-      // In the hang-over (the rotation no longer turns like handling, after the last window
-      // that did) the step waits for the walk after it; otherwise a waved/handled phone: no
-      // step, and the bout must start again after it.
-      const TimeNs last_features_ns = classifier_.handling_features_last_ns();
-      if (opt_.hangover_steps_wait && !classifier_.handling_features() && last_features_ns >= 0 &&
-          c.t_ns > last_features_ns) {
+      // In the hang-over the step waits for the walk after it; otherwise a waved/handled
+      // phone: no step, and the bout must start again after it.
+      if (in_handling_hangover(c.t_ns)) {
         hangover_.push_back(hold(c));
         continue;
       }
@@ -228,34 +219,52 @@ void Pdr::drop_hangover() {
   hangover_.clear();
 }
 
+bool Pdr::in_handling_hangover(TimeNs t_ns) const {
+  // after the last window whose rotation turned like handling, while state() still holds it
+  const TimeNs last_features_ns = classifier_.handling_features_last_ns();
+  return opt_.hangover_steps_wait && !classifier_.handling_features() && last_features_ns >= 0 &&
+         t_ns > last_features_ns;
+}
+
+bool Pdr::hangover_expired(TimeNs last_held_ns, TimeNs now_ns) const {
+  // handling again, or no step followed (the next one, due within max_step_interval_s, is
+  // reported up to one more interval later): the held ones were not a walk
+  return classifier_.handling_features() || now_ns - last_held_ns > 2 * s_to_ns(opt_.detector.max_step_interval_s);
+}
+
+bool Pdr::in_walking_rhythm(const std::vector<TimeNs>& t_ns) const {
+  const TimeNs lo = s_to_ns(opt_.detector.min_step_interval_s), hi = s_to_ns(opt_.detector.max_step_interval_s);
+  for (std::size_t i = 1; i < t_ns.size(); ++i)
+    if (t_ns[i] - t_ns[i - 1] < lo || t_ns[i] - t_ns[i - 1] > hi) return false;
+  return true;
+}
+
+Pdr::HeldStep Pdr::turned_back(const HeldStep& next, TimeNs t_ns, double vertical_yaw_rad) {
+  // Taken while the heading offset restarted and the placement bout had ended (handling): the
+  // walk's direction is the next step's (a second or less later), turned back by the gyro's yaw
+  // about the vertical between the two steps (left positive).
+  HeldStep h = next;
+  h.candidate.t_ns = t_ns;
+  h.heading_rad = wrap_two_pi(next.heading_rad + (next.vertical_yaw_rad - vertical_yaw_rad));
+  return h;
+}
+
 void Pdr::settle_hangover(const HeldStep& next, TimeNs now_ns) {
   if (hangover_.empty()) return;
-  // the rhythm: every interval from the first hang-over step to the next step a step's
-  const TimeNs lo = s_to_ns(opt_.detector.min_step_interval_s), hi = s_to_ns(opt_.detector.max_step_interval_s);
-  TimeNs prev = hangover_.front().candidate.t_ns;
-  bool rhythm = true;
-  for (std::size_t i = 1; i <= hangover_.size(); ++i) {
-    const TimeNs t = i < hangover_.size() ? hangover_[i].candidate.t_ns : next.candidate.t_ns;
-    rhythm = rhythm && t - prev >= lo && t - prev <= hi;
-    prev = t;
-  }
-  if (!rhythm) {
+  std::vector<TimeNs> times;  // the hang-over steps, then the next one
+  for (const HeldStep& h : hangover_) times.push_back(h.candidate.t_ns);
+  times.push_back(next.candidate.t_ns);
+  if (!in_walking_rhythm(times)) {
     drop_hangover();
     return;
   }
   std::vector<HeldStep> steps;
   steps.swap(hangover_);
-  for (HeldStep& h : steps) {
-    // Taken while the heading offset restarted and the placement bout had ended (handling):
-    // the walk's direction is the next step's (a second or less later), turned back by the
-    // gyro's yaw about the vertical between the two steps (left positive).
-    const StepCandidate own = h.candidate;
-    const double turned_rad = next.vertical_yaw_rad - h.vertical_yaw_rad;
-    h = next;
-    h.candidate = own;
-    h.heading_rad = wrap_two_pi(next.heading_rad + turned_rad);
+  for (const HeldStep& held : steps) {
+    HeldStep h = turned_back(next, held.candidate.t_ns, held.vertical_yaw_rad);
+    h.candidate = held.candidate;  // its own swing and interval
     ++counters_.steps_from_handling_hangover;
-    release(gate_.push(own.t_ns, std::move(h)), now_ns);
+    release(gate_.push(h.candidate.t_ns, std::move(h)), now_ns);
   }
 }
 
@@ -522,9 +531,7 @@ void Pdr::feed(const StepDetectorSample& s) {
   last_android_ns_ = s.t_ns;
   if (opt_.gate_handling && (classifier_.state() == MotionState::kHandling || classifier_.handling_at(s.t_ns))) {
     // in the hang-over the event waits for the walk after it, as the accelerometer's steps do
-    const TimeNs last_features_ns = classifier_.handling_features_last_ns();
-    if (opt_.hangover_steps_wait && !classifier_.handling_features() && last_features_ns >= 0 &&
-        s.t_ns > last_features_ns) {
+    if (in_handling_hangover(s.t_ns)) {
       android_hangover_.emplace_back(s.t_ns, tracker_.yaw_rad());
     } else {
       drop_android_hangover();
@@ -556,19 +563,13 @@ void Pdr::feed(const StepDetectorSample& s) {
     };
     // the hang-over's events count when this one follows in their rhythm (settle_hangover)
     if (!android_hangover_.empty()) {
-      const TimeNs lo = s_to_ns(opt_.detector.min_step_interval_s), hi = s_to_ns(opt_.detector.max_step_interval_s);
-      bool rhythm = true;
-      for (std::size_t i = 0; i < android_hangover_.size(); ++i) {
-        const TimeNs t = i + 1 < android_hangover_.size() ? android_hangover_[i + 1].first : s.t_ns;
-        rhythm = rhythm && t - android_hangover_[i].first >= lo && t - android_hangover_[i].first <= hi;
-      }
-      if (!rhythm) drop_android_hangover();
+      std::vector<TimeNs> times;
+      for (const auto& held : android_hangover_) times.push_back(held.first);
+      times.push_back(s.t_ns);
+      if (!in_walking_rhythm(times)) drop_android_hangover();
       for (const auto& [t_ns, vertical_yaw_rad] : android_hangover_) {
-        HeldStep x = h;
-        x.candidate.t_ns = t_ns;
-        x.heading_rad = wrap_two_pi(h.heading_rad + (h.vertical_yaw_rad - vertical_yaw_rad));
         ++counters_.steps_from_handling_hangover;
-        emit_android(x);
+        emit_android(turned_back(h, t_ns, vertical_yaw_rad));
       }
       android_hangover_.clear();
     }

@@ -310,6 +310,14 @@ class Pdr {
   /// The next step outside handling: the hang-over steps count if their rhythm leads to it,
   /// with its heading and walking direction.
   void settle_hangover(const HeldStep& next, TimeNs now_ns);
+  /// A step at t_ns falls in handling's hang-over and may wait (hangover_steps_wait).
+  bool in_handling_hangover(TimeNs t_ns) const;
+  /// Held hang-over steps whose latest is last_held_ns are no walk by now_ns.
+  bool hangover_expired(TimeNs last_held_ns, TimeNs now_ns) const;
+  /// Every interval of these step times within the detector's min / max step interval.
+  bool in_walking_rhythm(const std::vector<TimeNs>& t_ns) const;
+  /// The next step at a held step's time, its heading turned back by the vertical yaw between.
+  static HeldStep turned_back(const HeldStep& next, TimeNs t_ns, double vertical_yaw_rad);
   PlacementEstimator placement_;
   HeadingFusion fusion_;
   QuasiStaticField qsf_;
