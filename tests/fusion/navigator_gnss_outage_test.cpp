@@ -120,6 +120,63 @@ TEST_P(MountainViewGap, NoShownJumpAbove3SigmaAndAfterTheGapNoWorseThanGnssAlone
 
 INSTANTIATE_TEST_SUITE_P(RawGapAndRawPlusFixGap, MountainViewGap, ::testing::Values(false, true));
 
+/// The GNSS engine's own estimate, as Navigator::output() lists it (engines.csv, the app's dots).
+Estimate gnss_engine(const Navigator& nav) {
+  for (const Estimate& e : nav.output(0).engines)
+    if (e.engine == EngineKind::kGnss) return e;
+  return Estimate{};
+}
+
+// When GNSS epochs stop altogether (a tunnel, a jammer) the GNSS engine's newest estimate is that
+// of its last epoch: it used to stay "ok" with that epoch's metre-level covariance however long
+// the walker walked on (a simulated 1071 s outage: "ok", 2 m semi-major, 870-950 m off). It is
+// lost once no epoch came for 3 s, in the engines list and as the shown estimate of the GNSS-only
+// mode, and tracking again with the first epoch after the gap. The log's Fix rows go on through
+// the gap (the time advances without Raw epochs).
+TEST(NavigatorGnssEngineOutput, NoEpochForThreeSecondsIsLostNotOk) {
+  const std::vector<Sample> log = read_log();
+  TimeNs first_raw = -1;
+  for (const Sample& s : log)
+    if (std::holds_alternative<GnssRawSample>(s)) { first_raw = sample_time_ns(s); break; }
+  ASSERT_GE(first_raw, 0);
+  const TimeNs gap_from = first_raw + 90 * kNsPerS, gap_to = gap_from + 60 * kNsPerS;
+  for (const EngineMode mode : {EngineMode::kAuto, EngineMode::kGnss}) {
+    NavigatorConfig cfg;
+    cfg.mode = mode;
+    cfg.nav_paths.push_back(test::shared_data("gnss-mountainview/hour2350.16n"));
+    Navigator nav(cfg, 7);
+    int ok_before = 0, lost_in_gap = 0, ok_in_gap = 0, ok_after = 0, checked_in_gap = 0;
+    std::string gap_reason;
+    for (const Sample& s : log) {
+      const TimeNs t = sample_time_ns(s);
+      if (t >= gap_from && t < gap_to && std::holds_alternative<GnssRawSample>(s)) continue;
+      nav.feed(s);
+      if (!std::holds_alternative<FixSample>(s)) continue;  // look once a Fix row (1 Hz)
+      const Estimate g = gnss_engine(nav);
+      if (t >= gap_from - 10 * kNsPerS && t < gap_from) ok_before += g.status == EstimateStatus::kOk;
+      if (t >= gap_from + 5 * kNsPerS && t < gap_to) {
+        ++checked_in_gap;
+        lost_in_gap += g.status == EstimateStatus::kLost;
+        ok_in_gap += g.status == EstimateStatus::kOk;
+        gap_reason = g.reason;
+        EXPECT_TRUE(std::isfinite(g.position.lat_deg())) << "the last epoch's position is kept";
+        if (mode == EngineMode::kGnss) EXPECT_FALSE(nav.estimate().valid()) << "GNSS-only shows a stale fix as valid";
+      }
+      if (t >= gap_to + 10 * kNsPerS && t < gap_to + 20 * kNsPerS) ok_after += g.valid();
+    }
+    std::printf("mode %s: GNSS engine ok %d of the 10 s before the gap; in the gap (%d looks) lost %d, ok %d (\"%s\"); "
+                "valid %d of 10 s after it\n",
+                mode == EngineMode::kAuto ? "auto" : "gnss", ok_before, checked_in_gap, lost_in_gap, ok_in_gap,
+                gap_reason.c_str(), ok_after);
+    EXPECT_GE(ok_before, 8);
+    ASSERT_GE(checked_in_gap, 45);
+    EXPECT_EQ(lost_in_gap, checked_in_gap);
+    EXPECT_EQ(ok_in_gap, 0);
+    EXPECT_NE(gap_reason.find("no epoch for"), std::string::npos);
+    EXPECT_GE(ok_after, 8);
+  }
+}
+
 }  // namespace
 }  // namespace pdnav::fusion
 

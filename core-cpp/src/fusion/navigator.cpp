@@ -128,6 +128,9 @@ struct Navigator::Impl {
   bool location_set = false;
   TimeNs last_t_ns = 0;
   TimeNs last_gnss_ok_ns = -1;
+  TimeNs last_gnss_epoch_ns = -1;         // time of the GNSS engine's newest epoch
+  double gnss_epoch_interval_s = 1.0;     // typical interval between its epochs (duty cycling)
+  int gnss_epoch_intervals = 0;
   std::int64_t steps = 0;
   std::int64_t first_utc_ms = kMissingInt;  // wall clock of the session (WMM date)
   geo::Geodetic start_position;
@@ -306,6 +309,13 @@ struct Navigator::Impl {
     if (!gnss) return;
     std::vector<gnss::EpochSolution> sols = gnss->take_solutions();
     const Estimate g = gnss->estimate();
+    if (g.t_ns > last_gnss_epoch_ns) {
+      if (last_gnss_epoch_ns >= 0) {
+        const double dt = static_cast<double>(g.t_ns - last_gnss_epoch_ns) * 1e-9;
+        if (dt < 60.0) gnss_epoch_interval_s = gnss_epoch_intervals++ == 0 ? dt : 0.8 * gnss_epoch_interval_s + 0.2 * dt;
+      }
+      last_gnss_epoch_ns = g.t_ns;
+    }
     // the fused estimate also starts from a degraded (< 6 satellites) fix, with its covariance
     if (g.status == EstimateStatus::kOk || (fused && !started && g.status == EstimateStatus::kDegraded)) {
       last_gnss_ok_ns = g.t_ns;
@@ -782,6 +792,23 @@ struct Navigator::Impl {
     shown = std::move(e);
   }
 
+  /// The GNSS engine's estimate as of now. It is its newest epoch's: while epochs come the
+  /// engine itself says degraded / lost (coasting, few satellites), but when they stop altogether
+  /// (a tunnel, a jammer, the receiver off) it would go on saying "ok" with that epoch's
+  /// covariance at a position the walker has long left. Past the freshness limit (kGnssFreshNs,
+  /// or 1.5 epoch intervals + 1 s when duty-cycled) it is lost; the position stays, as of then.
+  Estimate gnss_now() const {
+    Estimate g = gnss->estimate();
+    if (!g.valid()) return g;
+    const double age_s = static_cast<double>(last_t_ns - g.t_ns) * 1e-9;
+    const double limit_s = std::max(static_cast<double>(kGnssFreshNs) * 1e-9, 1.5 * gnss_epoch_interval_s + 1.0);
+    if (age_s > limit_s) {
+      g.status = EstimateStatus::kLost;
+      g.reason = "GNSS: no epoch for " + fmt(age_s) + " s (the position is the last epoch's)";
+    }
+    return g;
+  }
+
   Estimate choose() const {
     if (fused) {
       if (shown_valid) return shown;
@@ -789,7 +816,7 @@ struct Navigator::Impl {
       return d;
     }
     if (gnss && wants(cfg.mode, EngineMode::kGnss)) {
-      Estimate g = gnss->estimate();
+      Estimate g = gnss_now();
       const bool fresh = last_gnss_ok_ns >= 0 && last_t_ns - last_gnss_ok_ns <= kGnssFreshNs;
       if (cfg.mode == EngineMode::kGnss) return g;
       if (g.valid() && fresh) return g;
@@ -852,7 +879,7 @@ NavigatorOutput Navigator::output(std::size_t max_particles) const {
     o.particles_en_m = impl_->terrain->particles_en(max_particles);
   }
   if (impl_->route) o.engines.push_back(impl_->route->estimate());
-  if (impl_->gnss) o.engines.push_back(impl_->gnss->estimate());
+  if (impl_->gnss) o.engines.push_back(impl_->gnss_now());
   o.mode = impl_->mode;
   o.mode_change_count = impl_->change_count;
   const std::size_t n = std::min(kModeChangesInOutput, impl_->changes.size());
