@@ -31,6 +31,14 @@ std::vector<Sample> read_log() {
   return out;
 }
 
+/// Time of the log's first Raw row (-1 without one); the gap is cut from kGapStart after it.
+TimeNs first_raw_ns(const std::vector<Sample>& log) {
+  for (const Sample& s : log)
+    if (std::holds_alternative<GnssRawSample>(s)) return sample_time_ns(s);
+  return -1;
+}
+constexpr TimeNs kGapStart = 90 * kNsPerS, kGapLength = 60 * kNsPerS;
+
 struct OutageRun {
   double max_jump_sigma = 0.0;
   double max_jump_m = 0.0;
@@ -88,11 +96,9 @@ class MountainViewGap : public ::testing::TestWithParam<bool> {};
 TEST_P(MountainViewGap, NoShownJumpAbove3SigmaAndAfterTheGapNoWorseThanGnssAlone) {
   const bool cut_fix = GetParam();
   const std::vector<Sample> log = read_log();
-  TimeNs first_raw = -1;
-  for (const Sample& s : log)
-    if (std::holds_alternative<GnssRawSample>(s)) { first_raw = sample_time_ns(s); break; }
+  const TimeNs first_raw = first_raw_ns(log);
   ASSERT_GE(first_raw, 0);
-  const TimeNs gap_from = first_raw + 90 * kNsPerS, gap_to = gap_from + 60 * kNsPerS;
+  const TimeNs gap_from = first_raw + kGapStart, gap_to = gap_from + kGapLength;
   const OutageRun fused = replay(log, EngineMode::kAuto, gap_from, gap_to, cut_fix);
   const OutageRun gnss = replay(log, EngineMode::kGnss, gap_from, gap_to, cut_fix);
   std::printf("cut_fix=%d fused: max jump %.2f sigma (%.1f m), gap err %.1f m, after-gap err %.2f m (%d epochs); "
@@ -135,11 +141,9 @@ Estimate gnss_engine(const Navigator& nav) {
 // the gap (the time advances without Raw epochs).
 TEST(NavigatorGnssEngineOutput, NoEpochForThreeSecondsIsLostNotOk) {
   const std::vector<Sample> log = read_log();
-  TimeNs first_raw = -1;
-  for (const Sample& s : log)
-    if (std::holds_alternative<GnssRawSample>(s)) { first_raw = sample_time_ns(s); break; }
+  const TimeNs first_raw = first_raw_ns(log);
   ASSERT_GE(first_raw, 0);
-  const TimeNs gap_from = first_raw + 90 * kNsPerS, gap_to = gap_from + 60 * kNsPerS;
+  const TimeNs gap_from = first_raw + kGapStart, gap_to = gap_from + kGapLength;
   for (const EngineMode mode : {EngineMode::kAuto, EngineMode::kGnss}) {
     NavigatorConfig cfg;
     cfg.mode = mode;
