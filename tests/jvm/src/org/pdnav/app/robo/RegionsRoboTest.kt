@@ -132,6 +132,10 @@ class RegionsRoboTest {
         assertEquals("No satellites: paths", WalkerWords.source(out(EngineKind.ROUTE, 2, 9.0), true))
         assertEquals("Dead reckoning only", WalkerWords.source(out(EngineKind.DEAD_RECKONING, 2, 40.0), true))
         assertEquals("Waiting for a first position", WalkerWords.source(null, true))
+        // the GNSS-only mode after 3 s without an epoch: lost, its last position kept, not "very good"
+        assertEquals("Position lost: no signal", WalkerWords.source(out(EngineKind.GNSS, 4, 2.0), true))
+        assertEquals("No position now", WalkerWords.position(out(EngineKind.GNSS, 4, 2.0).estimate))
+        assertEquals("±4 m, very good", WalkerWords.position(out(EngineKind.GNSS, 1, 4.0).estimate))
         assertEquals("±8 m, good", WalkerWords.position(8.2))
         assertEquals("±4 m, very good", WalkerWords.position(4.0))
         assertEquals("±15 m, good", WalkerWords.position(15.3), "the word of the number shown")

@@ -549,7 +549,7 @@ class MainActivity : Activity() {
         val has = e.valid && e.latDeg.isFinite()
         val sigma = if (has) Math.sqrt((e.covEastEastM2 + e.covNorthNorthM2).coerceAtLeast(0.0)) else Double.NaN
         // the walker's words
-        walkerPosition.text = WalkerWords.position(sigma)
+        walkerPosition.text = WalkerWords.position(e)
         walkerSource.text = WalkerWords.source(out, graphShown)
         updateRegionMessage()
         // the tester's line and numbers, one tap away

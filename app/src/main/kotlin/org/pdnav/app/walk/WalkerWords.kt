@@ -2,9 +2,11 @@ package org.pdnav.app.walk
 
 import org.pdnav.app.nav.EngineKind
 import org.pdnav.app.nav.EstimateStatus
+import org.pdnav.app.nav.NavEstimate
 import org.pdnav.app.nav.NavOutput
 import java.util.Locale
 import kotlin.math.roundToInt
+import kotlin.math.sqrt
 
 /**
  * What the main screen says to a walker, without engine jargon: how sure the position is
@@ -34,9 +36,21 @@ object WalkerWords {
         return "±${metres(sigmaM)}, ${quality(shown)}"
     }
 
+    /**
+     * The shown estimate's uncertainty in words ([position] of its DRMS); a position the core has
+     * marked lost (the GNSS-only mode once no epoch came for 3 s) is not given its old sigma.
+     */
+    fun position(e: NavEstimate): String {
+        if (!e.valid && e.status == EstimateStatus.LOST && e.latDeg.isFinite()) return NO_POSITION_NOW
+        val has = e.valid && e.latDeg.isFinite()
+        return position(if (has) sqrt((e.covEastEastM2 + e.covNorthNorthM2).coerceAtLeast(0.0)) else Double.NaN)
+    }
+
     /** Where the shown position comes from, in words. [graphLoaded]: walkway graph in use. */
     fun source(out: NavOutput?, graphLoaded: Boolean): String {
         val e = out?.estimate ?: return NO_POSITION
+        // a position the core no longer stands by (the GNSS-only mode once no epoch came for 3 s)
+        if (!e.valid && e.status == EstimateStatus.LOST && e.latDeg.isFinite()) return POSITION_LOST
         if (!e.valid || !e.latDeg.isFinite()) return NO_POSITION
         return when (e.engine) {
             EngineKind.GNSS -> if (e.status == EstimateStatus.OK) SATELLITES else SATELLITES_WEAK
@@ -79,4 +93,6 @@ object WalkerWords {
     const val PATHS = "No satellites: paths"
     const val DEAD_RECKONING = "Dead reckoning only"
     const val NO_POSITION = "Waiting for a first position"
+    const val POSITION_LOST = "Position lost: no signal"
+    const val NO_POSITION_NOW = "No position now"
 }
