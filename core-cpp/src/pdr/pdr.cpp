@@ -190,8 +190,8 @@ void Pdr::feed(const AccelSample& s) {
   }
   latest_ns_ = std::max(latest_ns_, s.t_ns);
   release(gate_.expire(s.t_ns), s.t_ns);
-  if (!hangover_.empty() && hangover_expired(hangover_.back().candidate.t_ns, s.t_ns)) drop_hangover();
-  if (!android_hangover_.empty() && hangover_expired(android_hangover_.back().first, s.t_ns)) drop_android_hangover();
+  expire_held(hangover_, s.t_ns);
+  expire_held(android_hangover_, s.t_ns);
   for (const auto& c : candidates) {
     if (opt_.gate_handling && (handling || classifier_.handling_at(c.t_ns))) {
       // In the hang-over the step waits for the walk after it; otherwise a waved/handled
@@ -200,13 +200,13 @@ void Pdr::feed(const AccelSample& s) {
         hangover_.push_back(hold(c));
         continue;
       }
-      drop_hangover();
+      drop_held(hangover_);
       ++counters_.steps_discarded_by_motion;
       (void)gate_.end_bout();
       continue;
     }
     HeldStep h = hold(c);
-    settle_hangover(h, s.t_ns);
+    for (HeldStep& held : settle_held(hangover_, h, true)) release(gate_.push(held.candidate.t_ns, std::move(held)), s.t_ns);
     last_swing_mps2_ = c.swing_mps2;
     last_swing_ns_ = c.t_ns;
     release(gate_.push(c.t_ns, std::move(h)), s.t_ns);
@@ -214,9 +214,9 @@ void Pdr::feed(const AccelSample& s) {
   trim_consistency(s.t_ns);
 }
 
-void Pdr::drop_hangover() {
-  counters_.steps_discarded_by_motion += static_cast<std::int64_t>(hangover_.size());
-  hangover_.clear();
+void Pdr::drop_held(std::vector<HeldStep>& held) {
+  counters_.steps_discarded_by_motion += static_cast<std::int64_t>(held.size());
+  held.clear();
 }
 
 bool Pdr::in_handling_hangover(TimeNs t_ns) const {
@@ -226,46 +226,39 @@ bool Pdr::in_handling_hangover(TimeNs t_ns) const {
          t_ns > last_features_ns;
 }
 
-bool Pdr::hangover_expired(TimeNs last_held_ns, TimeNs now_ns) const {
+void Pdr::expire_held(std::vector<HeldStep>& held, TimeNs now_ns) {
   // handling again, or no step followed (the next one, due within max_step_interval_s, is
   // reported up to one more interval later): the held ones were not a walk
-  return classifier_.handling_features() || now_ns - last_held_ns > 2 * s_to_ns(opt_.detector.max_step_interval_s);
+  if (!held.empty() && (classifier_.handling_features() ||
+                        now_ns - held.back().candidate.t_ns > 2 * s_to_ns(opt_.detector.max_step_interval_s)))
+    drop_held(held);
 }
 
-bool Pdr::in_walking_rhythm(const std::vector<TimeNs>& t_ns) const {
+std::vector<Pdr::HeldStep> Pdr::settle_held(std::vector<HeldStep>& held, const HeldStep& next, bool own_candidate) {
+  std::vector<HeldStep> out;
+  if (held.empty()) return out;
+  // the rhythm: every interval from the first held step to the next one a step's
   const TimeNs lo = s_to_ns(opt_.detector.min_step_interval_s), hi = s_to_ns(opt_.detector.max_step_interval_s);
-  for (std::size_t i = 1; i < t_ns.size(); ++i)
-    if (t_ns[i] - t_ns[i - 1] < lo || t_ns[i] - t_ns[i - 1] > hi) return false;
-  return true;
-}
-
-Pdr::HeldStep Pdr::turned_back(const HeldStep& next, TimeNs t_ns, double vertical_yaw_rad) {
-  // Taken while the heading offset restarted and the placement bout had ended (handling): the
-  // walk's direction is the next step's (a second or less later), turned back by the gyro's yaw
-  // about the vertical between the two steps (left positive).
-  HeldStep h = next;
-  h.candidate.t_ns = t_ns;
-  h.heading_rad = wrap_two_pi(next.heading_rad + (next.vertical_yaw_rad - vertical_yaw_rad));
-  return h;
-}
-
-void Pdr::settle_hangover(const HeldStep& next, TimeNs now_ns) {
-  if (hangover_.empty()) return;
-  std::vector<TimeNs> times;  // the hang-over steps, then the next one
-  for (const HeldStep& h : hangover_) times.push_back(h.candidate.t_ns);
-  times.push_back(next.candidate.t_ns);
-  if (!in_walking_rhythm(times)) {
-    drop_hangover();
-    return;
+  for (std::size_t i = 0; i < held.size(); ++i) {
+    const TimeNs dt = (i + 1 < held.size() ? held[i + 1].candidate.t_ns : next.candidate.t_ns) - held[i].candidate.t_ns;
+    if (dt < lo || dt > hi) {
+      drop_held(held);
+      return out;
+    }
   }
-  std::vector<HeldStep> steps;
-  steps.swap(hangover_);
-  for (const HeldStep& held : steps) {
-    HeldStep h = turned_back(next, held.candidate.t_ns, held.vertical_yaw_rad);
-    h.candidate = held.candidate;  // its own swing and interval
+  for (const HeldStep& x : held) {
+    // Taken while the heading offset restarted and the placement bout had ended (handling): the
+    // walk's direction is the next step's (a second or less later), turned back by the gyro's
+    // yaw about the vertical between the two steps (left positive).
+    HeldStep h = next;
+    if (own_candidate) h.candidate = x.candidate;  // its own swing and interval
+    h.candidate.t_ns = x.candidate.t_ns;
+    h.heading_rad = wrap_two_pi(next.heading_rad + (next.vertical_yaw_rad - x.vertical_yaw_rad));
     ++counters_.steps_from_handling_hangover;
-    release(gate_.push(h.candidate.t_ns, std::move(h)), now_ns);
+    out.push_back(std::move(h));
   }
+  held.clear();
+  return out;
 }
 
 Pdr::HeldStep Pdr::hold(const StepCandidate& c) const {
@@ -425,8 +418,8 @@ void Pdr::release(const std::vector<HeldStep>& steps, TimeNs now_ns) {
 }
 
 void Pdr::finish() {
-  drop_hangover();  // no walk followed
-  drop_android_hangover();
+  drop_held(hangover_);  // no walk followed
+  drop_held(android_hangover_);
   release(gate_.finish(), latest_ns_);
   settle_handling_wait(latest_ns_, true);
   settle_vehicle_wait(latest_ns_, true);
@@ -532,9 +525,12 @@ void Pdr::feed(const StepDetectorSample& s) {
   if (opt_.gate_handling && (classifier_.state() == MotionState::kHandling || classifier_.handling_at(s.t_ns))) {
     // in the hang-over the event waits for the walk after it, as the accelerometer's steps do
     if (in_handling_hangover(s.t_ns)) {
-      android_hangover_.emplace_back(s.t_ns, tracker_.yaw_rad());
+      HeldStep held;  // its time and the gyro's vertical yaw then are all settle_held needs
+      held.candidate.t_ns = s.t_ns;
+      held.vertical_yaw_rad = tracker_.yaw_rad();
+      android_hangover_.push_back(held);
     } else {
-      drop_android_hangover();
+      drop_held(android_hangover_);
       ++counters_.steps_discarded_by_motion;  // the phone's own detector counts waving too
     }
     trim_consistency(s.t_ns);
@@ -561,26 +557,11 @@ void Pdr::feed(const StepDetectorSample& s) {
         emit_step(x);
       }
     };
-    // the hang-over's events count when this one follows in their rhythm (settle_hangover)
-    if (!android_hangover_.empty()) {
-      std::vector<TimeNs> times;
-      for (const auto& held : android_hangover_) times.push_back(held.first);
-      times.push_back(s.t_ns);
-      if (!in_walking_rhythm(times)) drop_android_hangover();
-      for (const auto& [t_ns, vertical_yaw_rad] : android_hangover_) {
-        ++counters_.steps_from_handling_hangover;
-        emit_android(turned_back(h, t_ns, vertical_yaw_rad));
-      }
-      android_hangover_.clear();
-    }
+    // the hang-over's events count when this one follows in their rhythm, as the accelerometer's
+    for (const HeldStep& held : settle_held(android_hangover_, h, false)) emit_android(held);
     emit_android(h);
   }
   trim_consistency(s.t_ns);
-}
-
-void Pdr::drop_android_hangover() {
-  counters_.steps_discarded_by_motion += static_cast<std::int64_t>(android_hangover_.size());
-  android_hangover_.clear();
 }
 
 bool Pdr::android_active(TimeNs t_ns) const {

@@ -6,7 +6,6 @@
 #include <deque>
 #include <optional>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "pdnav/geo/events.h"
@@ -301,23 +300,20 @@ class Pdr {
   MotionClassifier classifier_;
   std::deque<HeldStep> vehicle_wait_;
   std::deque<HeldStep> handling_wait_;
-  /// Steps of the handling hang-over waiting for the walk after it (hangover_steps_wait).
-  std::vector<HeldStep> hangover_;
-  void drop_hangover();
-  /// The same for Android step events: (time, the gyro's vertical yaw then).
-  std::vector<std::pair<TimeNs, double>> android_hangover_;
-  void drop_android_hangover();
-  /// The next step outside handling: the hang-over steps count if their rhythm leads to it,
-  /// with its heading and walking direction.
-  void settle_hangover(const HeldStep& next, TimeNs now_ns);
+  /// Steps of the handling hang-over waiting for the walk after it (hangover_steps_wait): the
+  /// accelerometer's candidates, and Android step events (their time and vertical yaw only).
+  std::vector<HeldStep> hangover_, android_hangover_;
+  /// Held steps refused (counted as discarded by motion).
+  void drop_held(std::vector<HeldStep>& held);
+  /// ... refused once handling resumes or no step followed by now_ns.
+  void expire_held(std::vector<HeldStep>& held, TimeNs now_ns);
+  /// The next step outside handling: the held steps count (returned, `held` emptied) if every
+  /// interval from the first to it is within the detector's min / max step interval, each the
+  /// next step at its own time with the heading turned back by the gyro's vertical yaw between
+  /// (and its own candidate, swing and interval, with own_candidate); else they are refused.
+  std::vector<HeldStep> settle_held(std::vector<HeldStep>& held, const HeldStep& next, bool own_candidate);
   /// A step at t_ns falls in handling's hang-over and may wait (hangover_steps_wait).
   bool in_handling_hangover(TimeNs t_ns) const;
-  /// Held hang-over steps whose latest is last_held_ns are no walk by now_ns.
-  bool hangover_expired(TimeNs last_held_ns, TimeNs now_ns) const;
-  /// Every interval of these step times within the detector's min / max step interval.
-  bool in_walking_rhythm(const std::vector<TimeNs>& t_ns) const;
-  /// The next step at a held step's time, its heading turned back by the vertical yaw between.
-  static HeldStep turned_back(const HeldStep& next, TimeNs t_ns, double vertical_yaw_rad);
   PlacementEstimator placement_;
   HeadingFusion fusion_;
   QuasiStaticField qsf_;
