@@ -102,6 +102,18 @@ double wrap_2pi(double a) {
 
 constexpr TimeNs kGnssFreshNs = 3 * kNsPerS;  // a GNSS estimate older than this is "lost"
 
+/// Typical interval between GNSS events (the engine's epochs, accepted positions): the first
+/// interval, then an exponential average; a gap of 60 s or more is an outage, not the rate.
+struct IntervalAverage {
+  double s = 1.0;
+  int n = 0;
+  void add(double dt_s) {
+    if (dt_s > 0.0 && dt_s < 60.0) s = n++ == 0 ? dt_s : 0.8 * s + 0.2 * dt_s;
+  }
+  /// Still fresh this long after the last event: base_s, or 1.5 intervals + 1 s when duty-cycled.
+  double fresh_limit_s(double base_s) const { return std::max(base_s, 1.5 * s + 1.0); }
+};
+
 template <typename T, typename = void>
 struct has_utc : std::false_type {};
 template <typename T>
@@ -129,8 +141,7 @@ struct Navigator::Impl {
   TimeNs last_t_ns = 0;
   TimeNs last_gnss_ok_ns = -1;
   TimeNs last_gnss_epoch_ns = -1;         // time of the GNSS engine's newest epoch
-  double gnss_epoch_interval_s = 1.0;     // typical interval between its epochs (duty cycling)
-  int gnss_epoch_intervals = 0;
+  IntervalAverage gnss_epoch_interval;    // between its epochs (duty cycling)
   std::int64_t steps = 0;
   std::int64_t first_utc_ms = kMissingInt;  // wall clock of the session (WMM date)
   geo::Geodetic start_position;
@@ -150,8 +161,7 @@ struct Navigator::Impl {
   std::map<std::string, std::int64_t> counts;
   TimeNs last_gnss_ns = -1;               // last accepted GNSS (Raw or Fix) position
   TimeNs last_raw_pos_ns = -1;            // last Raw epoch with an SPP position (accepted or not)
-  double gnss_interval_s = 1.0;           // typical interval between accepted GNSS positions
-  int gnss_intervals = 0;
+  IntervalAverage gnss_interval;          // between accepted GNSS positions
   bool gnss_degraded = false;             // the last accepted one was degraded / Fix-only
   std::string gnss_what;                  // description of the last accepted GNSS measurement
   std::string last_event;                 // the last notable filter event (for the reason)
@@ -310,10 +320,7 @@ struct Navigator::Impl {
     std::vector<gnss::EpochSolution> sols = gnss->take_solutions();
     const Estimate g = gnss->estimate();
     if (g.t_ns > last_gnss_epoch_ns) {
-      if (last_gnss_epoch_ns >= 0) {
-        const double dt = static_cast<double>(g.t_ns - last_gnss_epoch_ns) * 1e-9;
-        if (dt < 60.0) gnss_epoch_interval_s = gnss_epoch_intervals++ == 0 ? dt : 0.8 * gnss_epoch_interval_s + 0.2 * dt;
-      }
+      if (last_gnss_epoch_ns >= 0) gnss_epoch_interval.add(static_cast<double>(g.t_ns - last_gnss_epoch_ns) * 1e-9);
       last_gnss_epoch_ns = g.t_ns;
     }
     // the fused estimate also starts from a degraded (< 6 satellites) fix, with its covariance
@@ -496,10 +503,7 @@ struct Navigator::Impl {
   }
 
   void accepted_gnss(TimeNs t, const Eigen::Vector2d& z, double sigma_m, bool degraded, const std::string& what) {
-    if (last_gnss_ns >= 0) {
-      const double dt = static_cast<double>(t - last_gnss_ns) * 1e-9;
-      if (dt > 0.0 && dt < 60.0) gnss_interval_s = gnss_intervals++ == 0 ? dt : 0.8 * gnss_interval_s + 0.2 * dt;
-    }
+    if (last_gnss_ns >= 0) gnss_interval.add(static_cast<double>(t - last_gnss_ns) * 1e-9);
     last_gnss_ns = t;
     gnss_degraded = degraded;
     gnss_what = what;
@@ -637,14 +641,13 @@ struct Navigator::Impl {
 
   bool gnss_fresh(TimeNs t) const {
     if (last_gnss_ns < 0) return false;
-    const double limit_s = std::max(fo().gnss_fresh_s, 1.5 * gnss_interval_s + 1.0);
-    return t - last_gnss_ns <= ns(limit_s);
+    return t - last_gnss_ns <= ns(gnss_interval.fresh_limit_s(fo().gnss_fresh_s));
   }
 
   /// While GNSS is good, terrain and route are held to the fused estimate (a wrong lock is
   /// found and corrected on the way).
   void anchor_engines(TimeNs t) {
-    if (!gnss_fresh(t) || t - last_gnss_ns > ns(1.0) + ns(gnss_interval_s)) return;
+    if (!gnss_fresh(t) || t - last_gnss_ns > ns(1.0) + ns(gnss_interval.s)) return;
     if (last_anchor_ns >= 0 && t - last_anchor_ns < ns(fo().anchor_interval_s)) return;
     last_anchor_ns = t;
     const Eigen::Vector2d m = ff.position_en_m();
@@ -801,8 +804,7 @@ struct Navigator::Impl {
     Estimate g = gnss->estimate();
     if (!g.valid()) return g;
     const double age_s = static_cast<double>(last_t_ns - g.t_ns) * 1e-9;
-    const double limit_s = std::max(static_cast<double>(kGnssFreshNs) * 1e-9, 1.5 * gnss_epoch_interval_s + 1.0);
-    if (age_s > limit_s) {
+    if (age_s > gnss_epoch_interval.fresh_limit_s(static_cast<double>(kGnssFreshNs) * 1e-9)) {
       g.status = EstimateStatus::kLost;
       g.reason = "GNSS: no epoch for " + fmt(age_s) + " s (the position is the last epoch's)";
     }
