@@ -35,6 +35,9 @@ data class NavEstimate(
     val valid: Boolean
         get() = status == EstimateStatus.OK || status == EstimateStatus.DEGRADED || status == EstimateStatus.AMBIGUOUS
 
+    /** Horizontal 1-sigma as DRMS, sqrt(cov_ee + cov_nn) (m). */
+    val drmsM: Double get() = sqrt((covEastEastM2 + covNorthNorthM2).coerceAtLeast(0.0))
+
     /** 1-sigma error ellipse: semi-axes (m) and major-axis orientation clockwise from north (rad). */
     fun ellipse(): Ellipse {
         val a = covEastEastM2

@@ -2,7 +2,6 @@ package org.pdnav.app.nav
 
 import kotlin.math.cos
 import kotlin.math.hypot
-import kotlin.math.sqrt
 
 /**
  * Feeds one session's sample stream into a navigator the same way live and in replay, so a
@@ -88,7 +87,7 @@ class SessionFeeder(val navigator: NativeNavigator) : SampleSink {
         val e = navigator.estimate()
         val c = if (e.valid && e.latDeg.isFinite()) {
             Checkpoint(tNs, latDeg, lonDeg, e.latDeg, e.lonDeg, horizontalDistanceM(latDeg, lonDeg, e.latDeg, e.lonDeg),
-                sqrt((e.covEastEastM2 + e.covNorthNorthM2).coerceAtLeast(0.0)), e.engine.label)
+                e.drmsM, e.engine.label)
         } else {
             Checkpoint(tNs, latDeg, lonDeg, Double.NaN, Double.NaN, Double.NaN, Double.NaN, e.engine.label)
         }

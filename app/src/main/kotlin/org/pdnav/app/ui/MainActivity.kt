@@ -547,7 +547,7 @@ class MainActivity : Activity() {
         lastOut = out
         val e = out.estimate
         val has = e.valid && e.latDeg.isFinite()
-        val sigma = if (has) Math.sqrt((e.covEastEastM2 + e.covNorthNorthM2).coerceAtLeast(0.0)) else Double.NaN
+        val sigma = if (has) e.drmsM else Double.NaN
         // the walker's words
         walkerPosition.text = WalkerWords.position(e)
         walkerSource.text = WalkerWords.source(out, graphShown)

@@ -6,7 +6,6 @@ import org.pdnav.app.nav.NavEstimate
 import org.pdnav.app.nav.NavOutput
 import java.util.Locale
 import kotlin.math.roundToInt
-import kotlin.math.sqrt
 
 /**
  * What the main screen says to a walker, without engine jargon: how sure the position is
@@ -41,16 +40,17 @@ object WalkerWords {
      * marked lost (the GNSS-only mode once no epoch came for 3 s) is not given its old sigma.
      */
     fun position(e: NavEstimate): String {
-        if (!e.valid && e.status == EstimateStatus.LOST && e.latDeg.isFinite()) return NO_POSITION_NOW
-        val has = e.valid && e.latDeg.isFinite()
-        return position(if (has) sqrt((e.covEastEastM2 + e.covNorthNorthM2).coerceAtLeast(0.0)) else Double.NaN)
+        if (lostWithPosition(e)) return NO_POSITION_NOW
+        return position(if (e.valid && e.latDeg.isFinite()) e.drmsM else Double.NaN)
     }
+
+    /** A position the core no longer stands by (the GNSS-only mode once no epoch came for 3 s). */
+    private fun lostWithPosition(e: NavEstimate) = !e.valid && e.status == EstimateStatus.LOST && e.latDeg.isFinite()
 
     /** Where the shown position comes from, in words. [graphLoaded]: walkway graph in use. */
     fun source(out: NavOutput?, graphLoaded: Boolean): String {
         val e = out?.estimate ?: return NO_POSITION
-        // a position the core no longer stands by (the GNSS-only mode once no epoch came for 3 s)
-        if (!e.valid && e.status == EstimateStatus.LOST && e.latDeg.isFinite()) return POSITION_LOST
+        if (lostWithPosition(e)) return POSITION_LOST
         if (!e.valid || !e.latDeg.isFinite()) return NO_POSITION
         return when (e.engine) {
             EngineKind.GNSS -> if (e.status == EstimateStatus.OK) SATELLITES else SATELLITES_WEAK
