@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include "pdnav/geo/frames.h"
 #include "pdnav/geo/samples.h"
 #include "pdnav/gnss/kalman.h"
 
@@ -157,6 +158,26 @@ TEST(KalmanFilter, DopplerVelocityAtBothEndsOfAGapFollowsAnAcceleratingTrack) {
   // the cross-covariance of the white-acceleration model moves the position by the mean velocity
   EXPECT_LT((kf.position().p_m - truth).norm(), 1.0);
   EXPECT_NEAR(kf.velocity_ecef_mps().x(), 20.0, 0.1);
+}
+
+TEST(KalmanFilter, DisplacementIsCheckedAgainstTheConstantVelocityPrediction) {
+  RobustKalman kf;
+  const Eigen::Matrix3d disp_cov = Eigen::Matrix3d::Identity() * 1e-4;
+  EXPECT_TRUE(std::isnan(kf.displacement_mahalanobis2(Eigen::Vector3d::Zero(), disp_cov, 1.0)));  // not started
+  kf.reset(kTruth, kFixCov, 0.0, 100.0);
+  const Eigen::Vector3d v(1.2, -0.5, 0.1);
+  kf.set_velocity(v, Eigen::Matrix3d::Identity() * 0.01, kNaN, kNaN);
+  // walking on (1 m^2/s^3 pedestrian PSD: 0.58 m per horizontal axis over 1 s), a 1 m turn-off
+  // to the east, a 10 m jump in the horizontal
+  const Eigen::Matrix3d enu_to_ecef = geo::ecef_to_enu_rotation(geo::to_geodetic(kTruth)).transpose();
+  const Eigen::Vector3d east = enu_to_ecef * Eigen::Vector3d(1.0, 0.0, 0.0);
+  const Eigen::Vector3d jump = enu_to_ecef * Eigen::Vector3d(6.0, 8.0, 0.0);
+  const double chi2_3 = 16.27;  // 3 degrees of freedom, 1e-3
+  EXPECT_LT(kf.displacement_mahalanobis2(v, disp_cov, 1.0), 0.01);
+  EXPECT_LT(kf.displacement_mahalanobis2(v + east, disp_cov, 1.0), chi2_3);
+  EXPECT_GT(kf.displacement_mahalanobis2(v + jump, disp_cov, 1.0), 10 * chi2_3);
+  // over a 5 s gap the same 10 m is a plausible change of velocity
+  EXPECT_LT(kf.displacement_mahalanobis2(5.0 * v + jump, disp_cov, 5.0), chi2_3);
 }
 
 TEST(KalmanFilter, DynamicsOptionSetsTheAccelerationPsd) {

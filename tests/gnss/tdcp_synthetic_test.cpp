@@ -79,6 +79,29 @@ TEST(TdcpSynthetic, UndetectedCycleSlipIsExcluded) {
   EXPECT_LT(s.disp_ecef_m.norm(), 2e-3);
 }
 
+TEST(TdcpSynthetic, SolutionsTheTestCannotVouchForAreMarked) {
+  const auto sky1 = synthetic_sky(kRx, 6, 17);
+  const auto sky2 = propagate_sky(sky1, 1.0);
+  const auto e1 = carrier(sky1, kRx.p_m, 0.0, Eigen::Vector3d::Zero(), 0.0);
+  const auto clean = carrier(sky2, kRx.p_m, 0.0, Eigen::Vector3d::Zero(), 0.0);
+  EXPECT_TRUE(solve_tdcp(e1, clean, 1.0, kRx, TdcpOptions{}).self_checked);  // 6 satellites, consistent
+  // 4 satellites, one slipped 2.5 m: no redundancy, the error goes into the solution unseen
+  auto four = std::vector<CarrierObservation>(clean.begin(), clean.begin() + 4);
+  four[1].adr_m += 2.5;
+  const DisplacementSolution s4 = solve_tdcp(e1, four, 1.0, kRx, TdcpOptions{});
+  ASSERT_TRUE(s4.ok);
+  EXPECT_FALSE(s4.self_checked);
+  EXPECT_GT(s4.disp_ecef_m.norm(), 1.0);
+  // 5 satellites, one slipped: the test fails, and with one degree of freedom it cannot tell which
+  auto five = std::vector<CarrierObservation>(clean.begin(), clean.begin() + 5);
+  five[1].adr_m += 2.5;
+  const DisplacementSolution s5 = solve_tdcp(e1, five, 1.0, kRx, TdcpOptions{});
+  ASSERT_TRUE(s5.ok);
+  EXPECT_FALSE(s5.self_checked);
+  five[1].adr_m -= 2.5;
+  EXPECT_TRUE(solve_tdcp(e1, five, 1.0, kRx, TdcpOptions{}).self_checked);
+}
+
 TEST(TdcpSynthetic, AdrRateInconsistentWithDopplerIsDropped) {
   const auto sky1 = synthetic_sky(kRx, 8, 14);
   const auto sky2 = propagate_sky(sky1, 1.0);

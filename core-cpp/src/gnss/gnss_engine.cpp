@@ -230,6 +230,16 @@ struct GnssEngine::Impl {
     }
     DisplacementSolution d = solve_tdcp(prev_obs, obs, dt, last_pos, opt.tdcp);
     merge(excluded, d.excluded);
+    if (d.ok && !d.self_checked && kf.initialized()) {
+      // TDCP is the KF's time update, not gated by it: a solution its own test could not
+      // check is checked against the filter's prediction instead
+      const double m2 = kf.displacement_mahalanobis2(d.disp_ecef_m, d.cov_ecef_m2, d.dt_s > 0.0 ? d.dt_s : dt);
+      if (!(m2 <= chi_square_quantile(opt.tdcp.fde_false_alarm, 3))) {
+        count("tdcp: unchecked by its own test and inconsistent with the KF (Doppler used)");
+        d.ok = false;
+        d.reason = "inconsistent with the KF";
+      }
+    }
     if (d.ok || !opt.use_doppler_fallback) {
       if (!d.ok) count("tdcp: " + d.reason);
       return d;

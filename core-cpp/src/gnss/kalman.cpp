@@ -91,6 +91,16 @@ void RobustKalman::predict(const Eigen::Vector3d& disp_m, const Eigen::Matrix3d&
   p_ = tidy(p_);
 }
 
+double RobustKalman::displacement_mahalanobis2(const Eigen::Vector3d& disp_m, const Eigen::Matrix3d& disp_cov,
+                                               double dt_s) const {
+  if (!initialized_ || !disp_m.allFinite() || !disp_cov.allFinite() || !(dt_s > 0.0)) return kNaN;
+  const Eigen::Vector3d nu = disp_m - x_.segment<3>(3) * dt_s;
+  const Eigen::Matrix3d s = p_.block<3, 3>(3, 3) * dt_s * dt_s + accel_psd_ecef() * (dt_s * dt_s * dt_s / 3.0) + disp_cov;
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(s);
+  if (ldlt.info() != Eigen::Success) return kNaN;
+  return nu.dot(ldlt.solve(nu));
+}
+
 void RobustKalman::coast(double dt_s) {
   if (!initialized_ || !(dt_s > 0.0) || !std::isfinite(dt_s)) return;
   Matrix f = Matrix::Identity();

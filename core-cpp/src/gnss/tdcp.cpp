@@ -32,6 +32,7 @@ struct WlsOut {
   Eigen::Vector4d x = Eigen::Vector4d::Zero();
   Eigen::Matrix4d cov = Eigen::Matrix4d::Identity();
   std::vector<SatId> used, excluded;
+  bool self_checked = true;
 };
 
 /// Weighted LS of y = -los . d + clock with chi-square FDE (exclude worst, repeat).
@@ -65,6 +66,7 @@ WlsOut robust_wls(std::vector<LinRow> rows, const TdcpOptions& opt, std::map<std
     if (!fails || dof < 2 || static_cast<int>(out.excluded.size()) >= opt.max_fde_exclusions) {
       for (const LinRow& r : rows) out.used.push_back(r.sat);
       out.ok = true;
+      out.self_checked = dof >= 1 && !fails;
       return out;
     }
     Eigen::Index worst = 0;
@@ -95,6 +97,7 @@ DisplacementSolution finish(const WlsOut& w, const char* source, double dt_s, do
   d.cov_ecef_m2 = w.cov.topLeftCorner<3, 3>() * scale * scale;
   d.clock_change_var_m2 = w.cov(3, 3) * scale * scale;
   d.used = w.used;
+  d.self_checked = w.self_checked;
   return d;
 }
 

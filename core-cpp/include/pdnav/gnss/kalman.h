@@ -117,6 +117,11 @@ class RobustKalman {
   void set_velocity(const Eigen::Vector3d& vel_mps, const Eigen::Matrix3d& vel_cov, double drift_mps,
                     double drift_var_m2ps2);
 
+  /// Squared Mahalanobis distance of a displacement measured over dt_s from this filter's
+  /// constant-velocity prediction v dt (covariance P_v dt^2 + S_a dt^3 / 3 + disp_cov); NaN
+  /// before initialisation. The check of a displacement without redundancy of its own.
+  double displacement_mahalanobis2(const Eigen::Vector3d& disp_m, const Eigen::Matrix3d& disp_cov, double dt_s) const;
+
   geo::Ecef position() const { return geo::Ecef(x_.head<3>()); }
   Eigen::Vector3d velocity_ecef_mps() const { return x_.segment<3>(3); }
   double clock_m() const { return x_(6); }

@@ -57,6 +57,11 @@ struct DisplacementSolution {
   double clock_change_var_m2 = 0.0;
   double dt_s = 0.0;
   std::vector<SatId> used;
+  // false when the chi-square test could not vouch for the solution: no redundant satellite
+  // (4 used), or failed with nothing left to exclude. A receiver autonomous integrity check
+  // detects nothing without redundancy (Brown, NAVIGATION 1992): such a displacement needs
+  // another check (the engine tests it against its KF's prediction).
+  bool self_checked = true;
   std::vector<SatId> excluded_fde;
   std::map<std::string, std::int64_t> excluded;
 };
