@@ -28,6 +28,8 @@ struct WalkResult {
   double max_jump_sigma = 0.0;
   PdrCalibration cal;
   std::vector<ModeChange> changes;
+  std::string reason_end_outage;  // the shown estimate's reason at the outage's last step
+  double end_outage_s = 0.0;      // ... and how long the outage had lasted then
 };
 
 /// with_course: the Fix rows carry the chipset's course over ground (the direction walked 1 s
@@ -104,6 +106,8 @@ WalkResult walk(std::uint64_t seed, double outage_s = 180.0, double start_off_m 
     } else if (outage) {
       res.fused_err_end_outage_m = (p - truth).norm();
       res.dr_err_end_outage_m = (truth_at_outage + (dr - dr_at_outage) - truth).norm();
+      res.reason_end_outage = e.reason;
+      res.end_outage_s = ts - open_s;
     } else if (ts > open_s + outage_s + 10.0) {
       sum_after += (p - truth).norm();
       ++n_after;
@@ -133,6 +137,14 @@ TEST(NavigatorFusionWalk, CalibratedPdrCarriesThroughA3MinuteOutageWithoutJumps)
       if (lost && c.to != FusionMode::kPdr && c.reason.find("re-acquired") != std::string::npos) back = true;
     }
     EXPECT_TRUE(lost && back) << seed;
+    // the shown reason says how long GNSS has been gone now (it said the seconds at the mode
+    // change, 3 s, through the whole outage)
+    const std::string key = "no usable GNSS for ";
+    const auto at = r.reason_end_outage.find(key);
+    ASSERT_NE(at, std::string::npos) << r.reason_end_outage;
+    const double said_s = std::stod(r.reason_end_outage.substr(at + key.size()));
+    EXPECT_GE(said_s, r.end_outage_s) << r.reason_end_outage;
+    EXPECT_LE(said_s, r.end_outage_s + 2.0) << r.reason_end_outage;
   }
 }
 

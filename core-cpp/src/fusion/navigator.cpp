@@ -156,6 +156,7 @@ struct Navigator::Impl {
   geo::LocalFrame frame;                  // fused frame (the start position)
   PdrCalibration applied;                 // calibration applied to the steps
   FusionMode mode = FusionMode::kNotStarted;
+  std::string mode_why;  // why the fused estimate is in its mode, as of the last refresh
   std::deque<ModeChange> changes;
   std::int64_t change_count = 0;
   std::map<std::string, std::int64_t> counts;
@@ -452,6 +453,7 @@ struct Navigator::Impl {
   }
 
   void set_mode(TimeNs t, FusionMode to, const std::string& why) {
+    mode_why = why;  // the shown reason is today's ("no GNSS for 300 s"), the change log keeps the first
     if (to == mode) return;
     ModeChange c{t, mode, to, why};
     changes.push_back(c);
@@ -787,7 +789,7 @@ struct Navigator::Impl {
       case FusionMode::kTerrain: e.engine = EngineKind::kTerrain; e.status = EstimateStatus::kDegraded; break;
       default: e.engine = EngineKind::kDeadReckoning; e.status = EstimateStatus::kDegraded; break;
     }
-    e.reason = std::string("fused (") + to_string(mode) + "): " + (changes.empty() ? "" : changes.back().reason);
+    e.reason = std::string("fused (") + to_string(mode) + "): " + mode_why;
     if (applied.valid)
       e.reason += "; PDR scale " + fmt(applied.scale, 3) + " heading bias " + fmt(rad_to_deg(applied.heading_bias_rad)) + " deg";
     if (offset_en_m.norm() > 0.0) e.reason += "; blending " + fmt(offset_en_m.norm()) + " m";
