@@ -293,3 +293,29 @@ TEST(FusionFilter, Chi2QuantileMatchesTables) {
 
 }  // namespace
 }  // namespace pdnav::fusion
+
+namespace pdnav::fusion {
+namespace {
+
+// The route engine's clusters weighed by the fused prediction (Navigator: route_cluster_association).
+TEST(AidAssociation, ThePredictionPicksAmongTheClustersAndSaysWhenItCannot) {
+  const Eigen::Matrix2d r = Eigen::Matrix2d::Identity() * 26.0;  // a 1 m cluster + the 5 m aiding floor
+  // the leading cluster (weight 0.7) 45 m east, a minority one (0.3) 8 m from a 10 m prediction
+  const std::vector<AidHypothesis> two = {{Eigen::Vector2d(45.0, 0.0), r, 0.7}, {Eigen::Vector2d(0.0, 8.0), r, 0.3}};
+  const AidAssociation near = associate(Eigen::Vector2d::Zero(), Eigen::Matrix2d::Identity() * 100.0, two);
+  EXPECT_EQ(near.index, 1);
+  EXPECT_LT(near.runner_up, 0.01);
+  // a 60 m prediction cannot tell them apart: the weights decide, and the other is close behind
+  const AidAssociation broad = associate(Eigen::Vector2d::Zero(), Eigen::Matrix2d::Identity() * 3600.0, two);
+  EXPECT_EQ(broad.index, 0);
+  EXPECT_GT(broad.runner_up, 0.3);
+  // symmetric clusters either side of the prediction: equally likely
+  const std::vector<AidHypothesis> sym = {{Eigen::Vector2d(-20.0, 0.0), r, 0.5}, {Eigen::Vector2d(20.0, 0.0), r, 0.5}};
+  EXPECT_NEAR(associate(Eigen::Vector2d::Zero(), Eigen::Matrix2d::Identity() * 100.0, sym).runner_up, 1.0, 1e-9);
+  // nothing usable
+  EXPECT_EQ(associate(Eigen::Vector2d::Zero(), Eigen::Matrix2d::Identity(), {}).index, -1);
+  EXPECT_EQ(associate(Eigen::Vector2d::Zero(), Eigen::Matrix2d::Identity(), {{Eigen::Vector2d(1.0, 0.0), r, 0.0}}).index, -1);
+}
+
+}  // namespace
+}  // namespace pdnav::fusion

@@ -418,4 +418,28 @@ void FusionFilter::clone(TimeNs t_ns) {
   clone_ok_ = true;
 }
 
+AidAssociation associate(const Eigen::Vector2d& x_en_m, const Eigen::Matrix2d& p_m2,
+                         const std::vector<AidHypothesis>& hypotheses) {
+  AidAssociation out;
+  double best = 0.0, second = 0.0;
+  for (std::size_t k = 0; k < hypotheses.size(); ++k) {
+    const AidHypothesis& h = hypotheses[k];
+    const Eigen::Matrix2d s = p_m2 + h.r_m2;
+    const double det = s.determinant();
+    if (!(det > 0.0) || !(h.weight > 0.0) || !h.z_en_m.allFinite()) continue;
+    const Eigen::Vector2d nu = h.z_en_m - x_en_m;
+    const double w = h.weight * std::exp(-0.5 * nu.dot(s.inverse() * nu)) / std::sqrt(det);
+    if (w > best) {
+      second = best;
+      best = w;
+      out.index = static_cast<int>(k);
+    } else if (w > second) {
+      second = w;
+    }
+  }
+  if (out.index >= 0 && best > 0.0) out.runner_up = second / best;
+  else out.index = -1;
+  return out;
+}
+
 }  // namespace pdnav::fusion

@@ -731,8 +731,32 @@ struct Navigator::Impl {
       return false;
     };
     bool used = false;
-    if (route && fo().aid_with_route) used = aid(route->estimate(), FusionMode::kRoute, &route_misses, "route");
+    if (route && fo().aid_with_route) used = aid(associated_route(), FusionMode::kRoute, &route_misses, "route");
     if (!used && terrain && fo().aid_with_terrain) aid(terrain->estimate(), FusionMode::kTerrain, &terrain_misses, "terrain");
+  }
+
+  /// The route engine's estimate for the fused filter: its leading cluster, or with
+  /// route_cluster_association the cluster the fused prediction makes most probable.
+  Estimate associated_route() {
+    Estimate lead = route->estimate();
+    if (!fo().route_cluster_association || !(lead.status == EstimateStatus::kOk || lead.status == EstimateStatus::kAmbiguous))
+      return lead;
+    const auto clusters = route->cluster_estimates();
+    if (clusters.size() < 2) return lead;
+    std::vector<AidHypothesis> h;
+    for (const auto& [e, w] : clusters)
+      h.push_back({frame.to_enu(e.position).p_m.head<2>(),
+                   e.cov_en_m2 * fo().aid_var_scale + fo().aid_min_sigma_m * fo().aid_min_sigma_m * Eigen::Matrix2d::Identity(), w});
+    const AidAssociation a = associate(ff.position_en_m(), ff.position_cov_m2(), h);
+    if (a.index < 0) return lead;
+    Estimate best = clusters[static_cast<std::size_t>(a.index)].first;
+    if (a.runner_up > route->options().ambiguity_ratio) {
+      best.status = EstimateStatus::kAmbiguous;
+      ++counts["route: clusters ambiguous under the fused prediction"];
+    } else if (a.index != 0) {
+      ++counts["route: a cluster other than the leading one chosen by the fused prediction"];
+    }
+    return best;
   }
 
   void refresh_mode(TimeNs t, const std::string& why_in = "") {

@@ -525,6 +525,23 @@ Estimate RouteEngine::estimate() const {
   return e;
 }
 
+std::vector<std::pair<Estimate, double>> RouteEngine::cluster_estimates() const {
+  std::vector<std::pair<Estimate, double>> out;
+  const Estimate best = estimate();
+  if (routes_.empty() || clusters_.empty() || !best.valid()) return out;
+  double total = 0.0;
+  for (const Cluster& c : clusters_) total += c.weight;
+  for (const Cluster& c : clusters_) {
+    Estimate e = best;
+    e.status = EstimateStatus::kOk;
+    e.en_m = c.mean_en_m;
+    e.cov_en_m2 = c.cov_en_m2 + Eigen::Matrix2d::Identity();
+    e.position = graph_->frame().to_geodetic(geo::Enu(c.mean_en_m.x(), c.mean_en_m.y(), 0.0));
+    out.emplace_back(e, total > 0.0 ? c.weight / total : 0.0);
+  }
+  return out;
+}
+
 bool RouteEngine::needs_fix() const {
   if (!initialised_) return true;
   return routes_.empty() || truncated_ || routes_.size() > opt_.fix_request_routes ||

@@ -201,4 +201,21 @@ class FusionFilter {
 /// chi^2 quantile (Wilson-Hilferty), for the gates.
 double chi2_quantile(int dof, double p);
 
+/// One hypothesis of a multi-modal aiding engine (the route engine's position clusters): where
+/// it puts the walker, its covariance as the filter would use it (R), and its prior weight.
+struct AidHypothesis {
+  Eigen::Vector2d z_en_m = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d r_m2 = Eigen::Matrix2d::Identity();
+  double weight = 0.0;
+};
+struct AidAssociation {
+  int index = -1;          // the most probable hypothesis (-1: none has any probability)
+  double runner_up = 0.0;  // the next one's posterior weight relative to it (0..1)
+};
+/// Probabilistic data association (Bar-Shalom & Tse, Automatica 1975): each hypothesis's
+/// posterior weight is its prior weight times N(z; x, P + R); the most probable one, and how
+/// close the next comes.
+AidAssociation associate(const Eigen::Vector2d& x_en_m, const Eigen::Matrix2d& p_m2,
+                         const std::vector<AidHypothesis>& hypotheses);
+
 }  // namespace pdnav::fusion

@@ -82,6 +82,12 @@ struct FusionOptions {
   double aid_var_scale = 1.0;         // ... their covariance times this
   double aid_min_sigma_m = 5.0;       // ... plus this 1-sigma (map/model error the engines do not state)
   bool aid_with_route = true;
+  /// In an outage the route engine's position clusters are weighed by the fused prediction
+  /// (probabilistic data association, Bar-Shalom & Tse 1975: weight x N(cluster; fused, P + R))
+  /// and the most probable one is the measurement, used when the next one weighs less than the
+  /// route engine's ambiguity ratio of it. false: the route engine's leading cluster when it is
+  /// unambiguous on its own weights.
+  bool route_cluster_association = true;
   /// The route engine's along-track covariance grows with the filter's residual scale sigma
   /// (the steps it is fed are calibrated by the same calibration), not APT's fixed 5 %: on
   /// eval-fusion walks whose calibration was learnt on a steeper grade the route claimed a few

@@ -93,6 +93,9 @@ class RouteEngine {
   /// Too many routes or clusters: the caller should obtain a GNSS fix.
   bool needs_fix() const;
   std::vector<Candidate> candidates(std::size_t max) const;
+  /// Every position cluster as an estimate (its routes' weighted mean and covariance, as
+  /// estimate() reports the leading one), with its share of the routes' weight; best first.
+  std::vector<std::pair<Estimate, double>> cluster_estimates() const;
 
   /// 1-sigma of the fed steps' length scale error (fraction), for the along-track part of the
   /// covariance estimate() reports (sigma x the distance since the route's last snap). The
