@@ -453,7 +453,7 @@ struct Navigator::Impl {
   }
 
   void set_mode(TimeNs t, FusionMode to, const std::string& why) {
-    mode_why = why;  // the shown reason is today's ("no GNSS for 300 s"), the change log keeps the first
+    mode_why = why;  // the shown reason is the current one ("no GNSS for 300 s"); the log keeps the change's
     if (to == mode) return;
     ModeChange c{t, mode, to, why};
     changes.push_back(c);
@@ -695,6 +695,12 @@ struct Navigator::Impl {
     }
   }
 
+  /// R of an engine's estimate as an aiding measurement: its covariance times aid_var_scale plus
+  /// the aid_min_sigma_m floor (what the engines do not state).
+  Eigen::Matrix2d aid_covariance(const Eigen::Matrix2d& cov_en_m2) const {
+    return cov_en_m2 * fo().aid_var_scale + fo().aid_min_sigma_m * fo().aid_min_sigma_m * Eigen::Matrix2d::Identity();
+  }
+
   /// In an outage, the route and terrain engines' estimates are measurements.
   void engine_aid(TimeNs t) {
     if (last_gnss_ns >= 0 && t - last_gnss_ns < ns(fo().aid_after_s)) return;
@@ -703,8 +709,7 @@ struct Navigator::Impl {
     auto aid = [&](const Estimate& e, FusionMode which, int* misses, const char* name) {
       if (e.status != EstimateStatus::kOk) return false;
       const Eigen::Vector2d z = frame.to_enu(e.position).p_m.head<2>();
-      Eigen::Matrix2d r = e.cov_en_m2 * fo().aid_var_scale;
-      r += fo().aid_min_sigma_m * fo().aid_min_sigma_m * Eigen::Matrix2d::Identity();
+      const Eigen::Matrix2d r = aid_covariance(e.cov_en_m2);
       const Eigen::Vector2d before = ff.position_en_m();
       const PositionUpdateResult res = fo().aid_covariance_intersection ? ff.update_position_ci(t, z, r)
                                                                          : ff.update_position(t, z, r, /*use_gate_policy=*/false);
@@ -745,8 +750,7 @@ struct Navigator::Impl {
     if (clusters.size() < 2) return lead;
     std::vector<AidHypothesis> h;
     for (const auto& [e, w] : clusters)
-      h.push_back({frame.to_enu(e.position).p_m.head<2>(),
-                   e.cov_en_m2 * fo().aid_var_scale + fo().aid_min_sigma_m * fo().aid_min_sigma_m * Eigen::Matrix2d::Identity(), w});
+      h.push_back({frame.to_enu(e.position).p_m.head<2>(), aid_covariance(e.cov_en_m2), w});
     const AidAssociation a = associate(ff.position_en_m(), ff.position_cov_m2(), h);
     if (a.index < 0) return lead;
     Estimate best = clusters[static_cast<std::size_t>(a.index)].first;

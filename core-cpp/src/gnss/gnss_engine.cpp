@@ -235,9 +235,9 @@ struct GnssEngine::Impl {
       // check is checked against the filter's prediction instead
       const double m2 = kf.displacement_mahalanobis2(d.disp_ecef_m, d.cov_ecef_m2, d.dt_s > 0.0 ? d.dt_s : dt);
       if (!(m2 <= chi_square_quantile(opt.tdcp.fde_false_alarm, 3))) {
-        count("tdcp: unchecked by its own test and inconsistent with the KF (Doppler used)");
         d.ok = false;
-        d.reason = "inconsistent with the KF";
+        d.reason = "unchecked by its own test and inconsistent with the KF";
+        if (opt.use_doppler_fallback) count("tdcp: " + d.reason + " (Doppler used)");  // else counted below
       }
     }
     if (d.ok || !opt.use_doppler_fallback) {

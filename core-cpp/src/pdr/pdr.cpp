@@ -237,7 +237,7 @@ void Pdr::expire_held(std::vector<HeldStep>& held, TimeNs now_ns) {
 std::vector<Pdr::HeldStep> Pdr::settle_held(std::vector<HeldStep>& held, const HeldStep& next, bool own_candidate) {
   std::vector<HeldStep> out;
   if (held.empty()) return out;
-  // the rhythm: every interval from the first held step to the next one a step's
+  // the rhythm: every interval, from the first held step to the next step, within a step's
   const TimeNs lo = s_to_ns(opt_.detector.min_step_interval_s), hi = s_to_ns(opt_.detector.max_step_interval_s);
   for (std::size_t i = 0; i < held.size(); ++i) {
     const TimeNs dt = (i + 1 < held.size() ? held[i + 1].candidate.t_ns : next.candidate.t_ns) - held[i].candidate.t_ns;

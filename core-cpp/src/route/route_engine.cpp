@@ -499,7 +499,7 @@ void RouteEngine::update_clusters() {
   }
   std::sort(clusters_.begin(), clusters_.end(), [](const Cluster& a, const Cluster& b) { return a.weight > b.weight; });
   last_en_m_ = clusters_.front().mean_en_m;
-  last_cov_ = clusters_.front().cov_en_m2 + Eigen::Matrix2d::Identity();
+  last_cov_ = clusters_.front().reported_cov_en_m2();
 }
 
 Estimate RouteEngine::estimate() const {
@@ -535,7 +535,7 @@ std::vector<std::pair<Estimate, double>> RouteEngine::cluster_estimates() const 
     Estimate e = best;
     e.status = EstimateStatus::kOk;
     e.en_m = c.mean_en_m;
-    e.cov_en_m2 = c.cov_en_m2 + Eigen::Matrix2d::Identity();
+    e.cov_en_m2 = c.reported_cov_en_m2();
     e.position = graph_->frame().to_geodetic(geo::Enu(c.mean_en_m.x(), c.mean_en_m.y(), 0.0));
     out.emplace_back(e, total > 0.0 ? c.weight / total : 0.0);
   }

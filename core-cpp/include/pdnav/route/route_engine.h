@@ -135,6 +135,9 @@ class RouteEngine {
     Eigen::Matrix2d cov_en_m2 = Eigen::Matrix2d::Zero();
     double weight = 0.0;
     std::size_t size = 0;
+    /// The covariance an estimate of this cluster reports: its routes' spread and along-track
+    /// variance, plus (1 m)^2 per axis.
+    Eigen::Matrix2d reported_cov_en_m2() const { return cov_en_m2 + Eigen::Matrix2d::Identity(); }
   };
 
   Eigen::Vector2d position(const Route& r) const;

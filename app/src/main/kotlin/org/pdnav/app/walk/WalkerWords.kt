@@ -45,7 +45,7 @@ object WalkerWords {
     }
 
     /** A position the core no longer stands by (the GNSS-only mode once no epoch came for 3 s). */
-    private fun lostWithPosition(e: NavEstimate) = !e.valid && e.status == EstimateStatus.LOST && e.latDeg.isFinite()
+    private fun lostWithPosition(e: NavEstimate) = e.status == EstimateStatus.LOST && e.latDeg.isFinite()
 
     /** Where the shown position comes from, in words. [graphLoaded]: walkway graph in use. */
     fun source(out: NavOutput?, graphLoaded: Boolean): String {
