@@ -330,6 +330,7 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
   j["steps_dropped_by_bout_gate"] = c.steps_discarded_by_bout_gate;
   j["steps_added_at_stride_midpoints"] = c.steps_added_at_stride_midpoints;
   j["steps_from_handling_hangover"] = c.steps_from_handling_hangover;
+  j["forward_channel_candidates"] = c.forward_channel_candidates;
   j["steps_before_their_bouts_direction"] = c.steps_before_their_bouts_direction;
   j["steps_refused_vehicle"] = c.steps_discarded_by_vehicle;
   j["max_step_delay_s"] = c.max_step_delay_s;  // longest step-to-emission latency

@@ -11,9 +11,19 @@
 
 namespace pdnav::pdr {
 
+namespace {
+/// The forward channel's detector: the accelerometer's options without stride splitting (a
+/// stride is an |a| notion).
+StepDetectorOptions forward_options(StepDetectorOptions o) {
+  o.stride_harmonic_ratio = 0.0;
+  return o;
+}
+}  // namespace
+
 Pdr::Pdr(const PdrOptions& options)
     : opt_(options),
       detector_(options.detector),
+      forward_detector_(forward_options(options.detector)),
       gate_(options.detector.bout_min_steps, options.detector.max_step_interval_s,
             options.detector.short_walk_min_steps),
       tracker_(options.heading.turn),
@@ -183,7 +193,8 @@ void Pdr::feed(const AccelSample& s) {
   gate_.set_min_steps(gyro_gate && opt_.detector.bout_min_steps_gyro > 0 ? opt_.detector.bout_min_steps_gyro
                                                                          : opt_.detector.bout_min_steps);
   detector_.set_running(opt_.gate_handling && classifier_.running());
-  const auto candidates = detector_.feed(s);
+  auto candidates = detector_.feed(s);
+  forward_candidates(s, candidates);
   if (detector_.counters().gaps != gaps_seen_) {  // a gap resets the detector and the bout
     gaps_seen_ = detector_.counters().gaps;
     release(gate_.end_bout(), s.t_ns);
@@ -212,6 +223,46 @@ void Pdr::feed(const AccelSample& s) {
     release(gate_.push(c.t_ns, std::move(h)), s.t_ns);
   }
   trim_consistency(s.t_ns);
+}
+
+void Pdr::forward_candidates(const AccelSample& s, std::vector<StepCandidate>& candidates) {
+  // One step is one cycle of |a| and one of the forward acceleration, a fraction of a step
+  // apart: across a change of channel a candidate within forward_same_step of the other
+  // channel's latest, in units of the forward channel's step interval, is that same step.
+  const double same = opt_.forward_same_step;
+  const double period_s = fwd_interval_s_ > 0.0 ? fwd_interval_s_ : opt_.detector.min_step_interval_s / same;
+  const TimeNs same_ns = s_to_ns(same * period_s);
+  std::vector<StepCandidate> kept;
+  for (const auto& c : candidates) {
+    if (last_forward_used_ns_ >= 0 && c.t_ns - last_forward_used_ns_ < same_ns && c.t_ns > last_forward_used_ns_) continue;
+    last_main_ns_ = c.t_ns;
+    last_candidate_ns_ = std::max(last_candidate_ns_, c.t_ns);
+    kept.push_back(c);
+  }
+  candidates.swap(kept);
+  if (!opt_.forward_steps || !placement_.ready() || !placement_.direction_known()) return;
+  // the levelled acceleration along the walking direction (phone axes), once the bout's direction
+  // is decided: its sign sets when a cycle completes, and a phone held the other way round must
+  // count the same steps
+  const Eigen::Vector3d up = placement_.up_phone();
+  Eigen::Vector3d fwd = placement_.forward_phone() - placement_.forward_phone().dot(up) * up;
+  if (fwd.norm() < 0.5) return;  // the walking axis near the vertical: no forward channel
+  fwd.normalize();
+  const Eigen::Vector3d a = s.acc_mps2 - s.acc_mps2.dot(up) * up;
+  for (StepCandidate c : forward_detector_.feed_value(s.t_ns, a.dot(fwd))) {
+    if (c.interval_s > 0.0 && c.interval_s <= opt_.detector.max_step_interval_s) fwd_interval_s_ = c.interval_s;
+    if (detector_.gate_open()) continue;  // |a| walks: its own candidates count
+    if (last_main_ns_ >= 0 && c.t_ns - last_main_ns_ < same_ns) continue;
+    if (last_candidate_ns_ >= 0 && ns_to_s(c.t_ns - last_candidate_ns_) < opt_.detector.min_step_interval_s) continue;
+    c.interval_s = last_candidate_ns_ >= 0 ? ns_to_s(c.t_ns - last_candidate_ns_) : 0.0;
+    const double span_s = std::min(c.interval_s > 0.0 ? c.interval_s : opt_.detector.max_step_interval_s,
+                                   opt_.detector.max_step_interval_s);
+    c.swing_mps2 = detector_.swing_between(c.t_ns - s_to_ns(span_s), c.t_ns);  // |a|'s, for Weinberg
+    if (!(c.swing_mps2 > 0.0)) c.swing_mps2 = kNaN;  // no |a| history: the length model's fallback
+    last_candidate_ns_ = last_forward_used_ns_ = c.t_ns;
+    candidates.push_back(c);
+    ++counters_.forward_channel_candidates;
+  }
 }
 
 void Pdr::drop_held(std::vector<HeldStep>& held) {

@@ -132,12 +132,36 @@ void StepDetector::push_window(TimeNs t_ns, double value) {
   }
 }
 
+double StepDetector::window_sigma() const {
+  const double n = static_cast<double>(window_.size());
+  if (n < 2.0) return 0.0;
+  const double mean = sum_ / n;
+  return std::sqrt(std::max(0.0, sum_sq_ / n - mean * mean));
+}
+
+double StepDetector::gate_sigma() const { return opt_.min_sigma_mps2; }
+
+bool StepDetector::gate_open() const {
+  const double sigma = window_sigma();
+  return sigma > 0.0 && sigma >= gate_sigma();
+}
+
+double StepDetector::swing_between(TimeNs from_ns, TimeNs to_ns) const {
+  double hi = -1e300, lo = 1e300;
+  for (const auto& h : history_) {
+    if (h.t_ns < from_ns || h.t_ns > to_ns) continue;
+    hi = std::max(hi, h.value);
+    lo = std::min(lo, h.value);
+  }
+  return hi >= lo ? hi - lo : 0.0;
+}
+
 StepDetector::Symbol StepDetector::quantise(double value) const {
   const double n = static_cast<double>(window_.size());
   if (n < 2.0) return Symbol::kUndefined;
   const double mean = sum_ / n;
-  const double sigma = std::sqrt(std::max(0.0, sum_sq_ / n - mean * mean));
-  if (sigma < opt_.min_sigma_mps2 || sigma <= 0.0) return Symbol::kUndefined;
+  const double sigma = window_sigma();
+  if (sigma < gate_sigma() || sigma <= 0.0) return Symbol::kUndefined;
   if (value > mean + opt_.k_sigma * sigma) return Symbol::kHigh;
   if (value < mean - opt_.k_sigma * sigma) return Symbol::kLow;
   return Symbol::kUndefined;
@@ -297,6 +321,22 @@ std::vector<StepCandidate> StepDetector::feed(const AccelSample& s) {
   }
   const auto c = on_symbol(quantise(value), s.t_ns, value);
   if (c) split_strides(*c, out);
+  return out;
+}
+
+std::vector<StepCandidate> StepDetector::feed_value(TimeNs t_ns, double value_in) {
+  std::vector<StepCandidate> out;
+  const SampleCheck check = check_sample(t_ns, std::isfinite(value_in), last_t_ns_, have_last_, opt_.gap_reset_s, counters_);
+  if (check == SampleCheck::kNonFinite || check == SampleCheck::kDuplicate || check == SampleCheck::kBackwards) {
+    return out;
+  }
+  if (check == SampleCheck::kGap) reset();
+  const double dt_s = have_last_ ? ns_to_s(t_ns - last_t_ns_) : 0.0;
+  have_last_ = true;
+  last_t_ns_ = t_ns;
+  const double value = filter(value_in, dt_s);
+  push_window(t_ns, value);
+  if (const auto c = on_symbol(quantise(value), t_ns, value)) out.push_back(*c);
   return out;
 }
 

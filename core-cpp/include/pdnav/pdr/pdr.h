@@ -55,6 +55,15 @@ struct PdrOptions {
   PlacementOptions placement;    // placement + walking direction when heading.mount == kAuto
   MotionClassifierOptions motion;  // walking / standing / handling
   bool gate_handling = true;     // no steps while the phone is handled or waved
+  /// Gentle steps from the forward acceleration (docs/pdr.md "Forward channel"): while |a| is
+  /// below the walking gate, the same level-crossing detector runs on the levelled acceleration
+  /// along the walking direction, whose oscillation marks each step (Zijlstra & Hof, Gait &
+  /// Posture 18(2) 2003: initial contact from the anterior-posterior trunk acceleration).
+  bool forward_steps = true;
+  /// A candidate of one channel within this fraction of the forward channel's step interval
+  /// after the other channel's latest is the same step (the heel strike's |a| peak and the
+  /// forward cycle are less than a step apart): counted once.
+  double forward_same_step = 0.75;
   /// A step taken in handling's hang-over (MotionClassifierOptions::hold_s after the rotation
   /// stopped looking like handling) waits for the walk after it: it counts when the next step
   /// outside handling follows in the walk's rhythm (every interval within the detector's
@@ -104,6 +113,7 @@ struct PdrCounters {
   double vehicle_max_score_s = 0.0;
   double vehicle_kinematic_max_mps2 = 0.0;
   std::int64_t steps_added_at_stride_midpoints = 0;  // swinging hand / running strides split (stage 4)
+  std::int64_t forward_channel_candidates = 0;  // candidates of the forward acceleration (forward_steps)
   std::int64_t steps_from_handling_hangover = 0;  // hang-over candidates and Android events the walk after them kept (hangover_steps_wait)
   /// Steps emitted before the placement bout they belong to had begun (its walking direction
   /// was waited for max_direction_wait_s in vain): they carry the previous bout's direction.
@@ -295,6 +305,11 @@ class Pdr {
 
   PdrOptions opt_;
   StepDetector detector_;
+  StepDetector forward_detector_;  // forward_steps: the forward acceleration channel
+  TimeNs last_candidate_ns_ = -1;  // the latest step candidate of either channel
+  TimeNs last_main_ns_ = -1;       // ... of the |a| channel
+  TimeNs last_forward_used_ns_ = -1;  // ... of the forward channel, counted
+  double fwd_interval_s_ = 0.0;    // the forward channel's latest step interval (its cadence)
   BoutGate<HeldStep> gate_;
   GyroTurnTracker tracker_;
   MotionClassifier classifier_;
@@ -305,6 +320,8 @@ class Pdr {
   std::vector<HeldStep> hangover_, android_hangover_;
   /// Held steps refused (counted as discarded by motion).
   void drop_held(std::vector<HeldStep>& held);
+  /// forward_steps: the forward channel's candidates while |a| is below its gate, appended.
+  void forward_candidates(const AccelSample& s, std::vector<StepCandidate>& candidates);
   /// ... refused once handling resumes or no step followed by now_ns.
   void expire_held(std::vector<HeldStep>& held, TimeNs now_ns);
   /// The next step outside handling: the held steps count (returned, `held` emptied) if every

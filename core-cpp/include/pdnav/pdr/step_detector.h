@@ -228,6 +228,13 @@ class StepDetector {
   /// The walker is running (Pdr: MotionClassifier::running()): strides down to
   /// running_stride_min_interval_s are recognised.
   void set_running(bool running) { running_ = running; }
+  /// The same detector on any scalar signal (no stride splitting, no tilt): the forward
+  /// acceleration channel of Pdr. Same hygiene, filter, window and symbols.
+  std::vector<StepCandidate> feed_value(TimeNs t_ns, double value);
+  /// The walking gate passed at the latest sample (sigma of the window >= the gate).
+  bool gate_open() const;
+  /// max - min of the filtered |a| over [from, to] (the stride history; 0 when none).
+  double swing_between(TimeNs from_ns, TimeNs to_ns) const;
   /// Steps added at stride midpoints so far (swinging-hand mode).
   std::int64_t stride_steps_added() const { return stride_steps_added_; }
   /// Clears all state but the counters (called on gaps).
@@ -250,6 +257,8 @@ class StepDetector {
   double filter(double magnitude, double dt_s);
   void push_window(TimeNs t_ns, double value);
   Symbol quantise(double value) const;
+  double window_sigma() const;
+  double gate_sigma() const;
   std::optional<StepCandidate> on_symbol(Symbol sym, TimeNs t_ns, double value);
   void split_strides(const StepCandidate& c, std::vector<StepCandidate>& out);
   /// by_gyro (optional): set true when the swing was read from the gyroscope, not the tilt.
