@@ -28,6 +28,7 @@
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -68,6 +69,7 @@ struct EvalPdrArgs {
   double wave_s = 0.0;        // seconds of synthesised calibration waving at the start point (0 = none)
   std::uint64_t wave_seed = 1;
   double wave_amplitude = 1.0;
+  double pitch_deg = 0.0;     // every walk with the phone pitched this much further (0 = as recorded)
   std::string sensors = "all";  // sensor set kept from each log (sensor_set_keeps)
   double segment_min_m = 0.0;   // 0: a segment per Truth line (surveyed waypoints)
   double align_start_s = 0.0;   // 0: no alignment (absolute tracks)
@@ -350,6 +352,47 @@ std::vector<Sample> read_samples(const std::string& path) {
   return out;
 }
 
+/// The walk with the phone pitched --pitch degrees further, top edge up, about the walk's
+/// horizontal lateral axis (+Y x the mean gravity, phone axes): the same physical walk with the
+/// phone held at another pitch, the top edge's heading kept (a reader holds a phone at 28-65 deg,
+/// issue 27). Every phone-axes stream is rotated: v' = R^T v for the accelerometer, gyroscope and
+/// magnetometer (and their uncalibrated twins with their biases), q' = q R for the rotation
+/// vectors; the Android orientation angles are dropped (they would be stale).
+std::vector<Sample> with_pitch(const std::vector<Sample>& in, double pitch_deg, const std::string& path) {
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  for (const Sample& s : in)
+    if (const auto* x = std::get_if<AccelSample>(&s)) up += x->acc_mps2;
+  const Eigen::Vector3d lateral = Eigen::Vector3d::UnitY().cross(up);
+  if (!(up.norm() > 0.0) || lateral.norm() < 0.1 * up.norm())
+    throw std::runtime_error(path + ": --pitch needs accelerometer samples and a phone whose +Y axis is not vertical on average");
+  const Eigen::AngleAxisd rot(pitch_deg * kDegToRad, lateral.normalized());  // the new phone axes in the old ones
+  const Eigen::Matrix3d rt = rot.toRotationMatrix().transpose();
+  const Eigen::Quaterniond qr(rot);
+  const auto turn_q = [&](Eigen::Vector4d& xyzw) {
+    const Eigen::Quaterniond q = Eigen::Quaterniond(xyzw[3], xyzw[0], xyzw[1], xyzw[2]) * qr;
+    xyzw = Eigen::Vector4d(q.x(), q.y(), q.z(), q.w());
+  };
+  std::vector<Sample> out;
+  out.reserve(in.size());
+  for (Sample s : in) {
+    if (std::holds_alternative<OrientationSample>(s)) continue;
+    std::visit(
+        [&](auto& x) {
+          using T = std::decay_t<decltype(x)>;
+          if constexpr (std::is_same_v<T, AccelSample>) x.acc_mps2 = rt * x.acc_mps2;
+          else if constexpr (std::is_same_v<T, GyroSample>) x.rate_radps = rt * x.rate_radps;
+          else if constexpr (std::is_same_v<T, MagSample>) x.field_ut = rt * x.field_ut;
+          else if constexpr (std::is_same_v<T, UncalAccelSample>) x.acc_mps2 = rt * x.acc_mps2, x.bias_mps2 = rt * x.bias_mps2;
+          else if constexpr (std::is_same_v<T, UncalGyroSample>) x.rate_radps = rt * x.rate_radps, x.drift_radps = rt * x.drift_radps;
+          else if constexpr (std::is_same_v<T, UncalMagSample>) x.field_ut = rt * x.field_ut, x.bias_ut = rt * x.bias_ut;
+          else if constexpr (std::is_same_v<T, RotationVectorSample> || std::is_same_v<T, GameRotationVectorSample>) turn_q(x.quat_xyzw);
+        },
+        s);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
 /// The walk as if the walker had first waved the phone for --wave seconds standing at the first
 /// waypoint (the issue's "as recorded" sessions, which start with calibration waving): the first
 /// Truth line moves to the start of the waving, the synthesised samples (phonesim/handling.h)
@@ -454,6 +497,7 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
     }
   }
   TimeNs walk_start_ns = std::numeric_limits<TimeNs>::min();
+  if (a.pitch_deg != 0.0) samples = with_pitch(samples, a.pitch_deg, path);
   if (a.wave_s > 0.0) samples = with_waving(samples, a, path, &walk_start_ns);
   Runner run(a);
   NaivePdr naive;
@@ -790,6 +834,10 @@ void register_eval_pdr(CLI::App& app) {
   c->add_option("--wave-amplitude", a->wave_amplitude, "scale of the waving's rotation and translation")
       ->check(CLI::Range(0.0, 3.0))
       ->capture_default_str();
+  c->add_option("--pitch", a->pitch_deg,
+                 "every walk with the phone pitched this much further (deg, top edge up) about the walk's "
+                 "horizontal lateral axis: the same walk, the phone held at another pitch")
+      ->check(CLI::Range(-80.0, 80.0));
   c->add_flag("--quiet", a->quiet, "one line per walk");
   c->add_option("--sensors", a->sensors, "sensor set kept from each log: all | accel | imu | rv | uncal | game")
       ->capture_default_str();

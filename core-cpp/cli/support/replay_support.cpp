@@ -362,7 +362,8 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
                      {"start_s", ns_to_s(b.t_start_ns - t0_ns)},
                      {"end_s", ns_to_s(b.t_end_ns - t0_ns)},
                      {"forward_phone", {b.forward_phone.x(), b.forward_phone.y(), b.forward_phone.z()}},
-                     {"phase_corr", b.phase_corr}});
+                     {"phase_corr", b.phase_corr},
+                     {"tilt_swing_deg", std::isfinite(b.tilt_swing_deg) ? nlohmann::json(b.tilt_swing_deg) : nlohmann::json()}});
   }
   j["placements"] = bouts;
   // which absolute reference held the heading, per segment of consecutive steps (issue 27)

@@ -246,7 +246,7 @@ void Pdr::forward_candidates(const AccelSample& s, std::vector<StepCandidate>& c
   // count the same steps
   const Eigen::Vector3d up = placement_.up_phone();
   Eigen::Vector3d fwd = placement_.forward_phone() - placement_.forward_phone().dot(up) * up;
-  if (fwd.norm() < 0.5) return;  // the walking axis near the vertical: no forward channel
+  if (fwd.norm() < 0.2) return;  // the walking axis within 12 deg of the vertical: no forward channel (as forward_offset_rad)
   fwd.normalize();
   const Eigen::Vector3d a = s.acc_mps2 - s.acc_mps2.dot(up) * up;
   for (StepCandidate c : forward_detector_.feed_value(s.t_ns, a.dot(fwd))) {

@@ -36,12 +36,14 @@ void PlacementEstimator::start_bout(TimeNs t_ns) {
   cov_h_.setZero();
   cov_w_.setZero();
   sum_up_walk_.setZero();
-  var_v_ = n_corr_ = walking_s_ = 0.0;
+  var_v_ = n_corr_ = walking_s_ = swing_sq_ = swing_n_ = 0.0;
   prior_supported_ = reversed_ = prior_rejected_ = bout_levelled_ = false;
   // placement from the dominant gravity axis; the reference axis is the placement's prior
   // walking axis (flat: +Y, upright: -Z), else the most horizontal of +X, +Y, -Z
   const double ax = std::abs(up_.x()), ay = std::abs(up_.y()), az = std::abs(up_.z());
-  if (az >= ax && az >= ay && az >= opt_.flat_min) {
+  const bool held_in_front = up_.z() >= std::cos(opt_.held_front_max_pitch_rad) && up_.y() >= 0.0 &&
+                             ax <= std::sin(opt_.held_front_max_roll_rad);
+  if ((az >= ax && az >= ay && az >= opt_.flat_min) || held_in_front) {
     bout_.placement = Placement::kFlat;
     reference_ = Eigen::Vector3d::UnitY();
   } else if (ay >= ax && ay >= az && ay >= opt_.upright_min) {
@@ -151,6 +153,12 @@ void PlacementEstimator::feed(const AccelSample& s, bool walking) {
       const Eigen::Vector3d w_h = w_hp_out_ - w_hp_out_.dot(tilt_up_) * tilt_up_;
       cov_w_ += w_h * w_h.transpose();
       sum_up_walk_ += tilt_up_;
+    }
+    if (tilt_ok_) {
+      const double ang = std::acos(std::clamp(tilt_up_.dot(up_), -1.0, 1.0));
+      swing_sq_ += ang * ang;
+      swing_n_ += 1.0;
+      bout_.tilt_swing_deg = std::sqrt(swing_sq_ / swing_n_) / kDegToRad;
     }
     var_v_ += av * av;
     n_corr_ += 1.0;

@@ -47,6 +47,16 @@ const char* to_string(Placement p);
 struct PlacementOptions {
   double gravity_window_s = 2.0;       // mean of the accelerometer over about two strides
   double flat_min = 0.6;               // |up.z| the largest and >= this (53 deg tilt): screen up/down
+  // ... and a phone held in front at any pitch is that placement too: screen toward the sky by
+  // at least 90 deg - held_front_max_pitch_rad (up.z >= cos(pitch)), top edge at or above the
+  // horizon (up.y >= 0), rolled by less than held_front_max_roll_rad (|up.x| <= sin(roll)). A
+  // hand-held phone is held square to the body whatever its pitch (reading at 28-65 deg is
+  // common), so its top edge's horizontal projection is the walking direction and the hand's
+  // pitch at the step frequency the phase signature, as for a phone held flat; with |up.z| the
+  // largest alone, a pitch above 53 deg made it "upright", levelled, and its weaker levelled
+  // correlation reversed or turned walks (ILC walks rotated by 50 deg: 2.43 -> 3.60 m).
+  double held_front_max_pitch_rad = 70 * kDegToRad;
+  double held_front_max_roll_rad = 30 * kDegToRad;
   double upright_min = 0.6;            // |up.y| the largest and >= this: top up/down
   double change_angle_rad = 40 * kDegToRad;  // gravity moved this far in phone axes ...
   double change_hold_s = 1.5;          // ... for this long: a new placement bout
@@ -85,6 +95,9 @@ struct PlacementBout {
   Placement placement = Placement::kUnknown;
   Eigen::Vector3d forward_phone = Eigen::Vector3d::UnitY();  // walking direction, phone axes
   double phase_corr = 0.0;  // normalised vertical-forward correlation along forward_phone
+  /// RMS angle (deg) between the instantaneous gravity (tilt filter) and its 2 s mean while
+  /// walking: how much the phone tilts back and forth with the gait (nan without a gyroscope).
+  double tilt_swing_deg = kNaN;
 };
 
 class PlacementEstimator {
@@ -166,7 +179,8 @@ class PlacementEstimator {
   double var_v_ = 0.0, n_corr_ = 0.0;
   Eigen::Matrix3d cov_h_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d cov_w_ = Eigen::Matrix3d::Zero();  // levelled gait-band angular rate, walking (phone axes)
-  Eigen::Vector3d sum_up_walk_ = Eigen::Vector3d::Zero();  // tilt filter's up while walking (phone axes)
+  Eigen::Vector3d sum_up_walk_ = Eigen::Vector3d::Zero();
+  double swing_sq_ = 0.0, swing_n_ = 0.0;  // tilt swing while walking (PlacementBout::tilt_swing_deg)  // tilt filter's up while walking (phone axes)
   Eigen::Vector3d w_hp_in_ = Eigen::Vector3d::Zero(), w_hp_out_ = Eigen::Vector3d::Zero();
   TimeNs w_hp_ns_ = -1;
   double walking_s_ = 0.0;
