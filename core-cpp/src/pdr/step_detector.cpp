@@ -139,11 +139,9 @@ double StepDetector::window_sigma() const {
   return std::sqrt(std::max(0.0, sum_sq_ / n - mean * mean));
 }
 
-double StepDetector::gate_sigma() const { return opt_.min_sigma_mps2; }
-
 bool StepDetector::gate_open() const {
   const double sigma = window_sigma();
-  return sigma > 0.0 && sigma >= gate_sigma();
+  return sigma > 0.0 && sigma >= opt_.min_sigma_mps2;
 }
 
 double StepDetector::swing_between(TimeNs from_ns, TimeNs to_ns) const {
@@ -161,7 +159,7 @@ StepDetector::Symbol StepDetector::quantise(double value) const {
   if (n < 2.0) return Symbol::kUndefined;
   const double mean = sum_ / n;
   const double sigma = window_sigma();
-  if (sigma < gate_sigma() || sigma <= 0.0) return Symbol::kUndefined;
+  if (sigma < opt_.min_sigma_mps2 || sigma <= 0.0) return Symbol::kUndefined;
   if (value > mean + opt_.k_sigma * sigma) return Symbol::kHigh;
   if (value < mean - opt_.k_sigma * sigma) return Symbol::kLow;
   return Symbol::kUndefined;
@@ -291,19 +289,25 @@ void StepDetector::split_strides(const StepCandidate& c, std::vector<StepCandida
   ++stride_steps_added_;
 }
 
+std::optional<double> StepDetector::accept(TimeNs t_ns, bool finite, double raw, double* dt_s) {
+  const SampleCheck check = check_sample(t_ns, finite, last_t_ns_, have_last_, opt_.gap_reset_s, counters_);
+  if (check == SampleCheck::kNonFinite || check == SampleCheck::kDuplicate || check == SampleCheck::kBackwards)
+    return std::nullopt;
+  if (check == SampleCheck::kGap) reset();
+  *dt_s = have_last_ ? ns_to_s(t_ns - last_t_ns_) : 0.0;
+  have_last_ = true;
+  last_t_ns_ = t_ns;
+  const double value = filter(raw, *dt_s);
+  push_window(t_ns, value);
+  return value;
+}
+
 std::vector<StepCandidate> StepDetector::feed(const AccelSample& s) {
   std::vector<StepCandidate> out;
-  const bool finite = s.acc_mps2.allFinite();
-  const SampleCheck check = check_sample(s.t_ns, finite, last_t_ns_, have_last_, opt_.gap_reset_s, counters_);
-  if (check == SampleCheck::kNonFinite || check == SampleCheck::kDuplicate || check == SampleCheck::kBackwards) {
-    return out;
-  }
-  if (check == SampleCheck::kGap) reset();
-  const double dt_s = have_last_ ? ns_to_s(s.t_ns - last_t_ns_) : 0.0;
-  have_last_ = true;
-  last_t_ns_ = s.t_ns;
-  const double value = filter(s.acc_mps2.norm(), dt_s);
-  push_window(s.t_ns, value);
+  double dt_s = 0.0;
+  const std::optional<double> accepted = accept(s.t_ns, s.acc_mps2.allFinite(), s.acc_mps2.norm(), &dt_s);
+  if (!accepted) return out;
+  const double value = *accepted;
   if (opt_.stride_harmonic_ratio > 0.0) {
     // Tilt: the specific force low-passed (same two sections as |a|) and normalised.
     if (history_.empty()) {
@@ -326,17 +330,10 @@ std::vector<StepCandidate> StepDetector::feed(const AccelSample& s) {
 
 std::vector<StepCandidate> StepDetector::feed_value(TimeNs t_ns, double value_in) {
   std::vector<StepCandidate> out;
-  const SampleCheck check = check_sample(t_ns, std::isfinite(value_in), last_t_ns_, have_last_, opt_.gap_reset_s, counters_);
-  if (check == SampleCheck::kNonFinite || check == SampleCheck::kDuplicate || check == SampleCheck::kBackwards) {
-    return out;
-  }
-  if (check == SampleCheck::kGap) reset();
-  const double dt_s = have_last_ ? ns_to_s(t_ns - last_t_ns_) : 0.0;
-  have_last_ = true;
-  last_t_ns_ = t_ns;
-  const double value = filter(value_in, dt_s);
-  push_window(t_ns, value);
-  if (const auto c = on_symbol(quantise(value), t_ns, value)) out.push_back(*c);
+  double dt_s = 0.0;
+  const std::optional<double> value = accept(t_ns, std::isfinite(value_in), value_in, &dt_s);
+  if (!value) return out;
+  if (const auto c = on_symbol(quantise(*value), t_ns, *value)) out.push_back(*c);
   return out;
 }
 

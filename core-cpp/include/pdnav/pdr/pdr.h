@@ -320,7 +320,9 @@ class Pdr {
   std::vector<HeldStep> hangover_, android_hangover_;
   /// Held steps refused (counted as discarded by motion).
   void drop_held(std::vector<HeldStep>& held);
-  /// forward_steps: the forward channel's candidates while |a| is below its gate, appended.
+  /// The |a| candidates of this sample less those that are the forward channel's latest step
+  /// again (forward_same_step), then (forward_steps) the forward channel's own while |a| is
+  /// below its walking gate, appended.
   void forward_candidates(const AccelSample& s, std::vector<StepCandidate>& candidates);
   /// ... refused once handling resumes or no step followed by now_ns.
   void expire_held(std::vector<HeldStep>& held, TimeNs now_ns);

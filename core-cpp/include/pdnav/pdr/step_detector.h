@@ -258,7 +258,9 @@ class StepDetector {
   void push_window(TimeNs t_ns, double value);
   Symbol quantise(double value) const;
   double window_sigma() const;
-  double gate_sigma() const;
+  /// Input hygiene, gap reset, low-pass and window for one raw value; the filtered value, or
+  /// nothing when the sample is skipped (counted). dt_s: the time since the previous sample.
+  std::optional<double> accept(TimeNs t_ns, bool finite, double raw, double* dt_s);
   std::optional<StepCandidate> on_symbol(Symbol sym, TimeNs t_ns, double value);
   void split_strides(const StepCandidate& c, std::vector<StepCandidate>& out);
   /// by_gyro (optional): set true when the swing was read from the gyroscope, not the tilt.
