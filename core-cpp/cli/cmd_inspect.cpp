@@ -122,6 +122,9 @@ void run_inspect(const InspectArgs& a) {
                 static_cast<double>(t_max) * 1e-9, static_cast<double>(t_max - t_min) * 1e-9);
   print_skips(st, a.issues);
   for (const auto& [what, why] : st.not_used) std::printf("not used: %s: %s\n", what.c_str(), why.c_str());
+  if (st.reordered > 0)
+    std::printf("reordered: %lld motion-sensor samples read in time order, not file order (batched; the latest %.3f s late)\n",
+                static_cast<long long>(st.reordered), st.reorder_window_s);
   std::printf("samples: %lld skipped: %lld\n", static_cast<long long>(st.samples),
               static_cast<long long>(st.skipped_total()));
 }

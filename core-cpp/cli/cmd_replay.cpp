@@ -149,6 +149,7 @@ int run_replay(const ReplayArgs& a) {
   summary["samples"] = reader.stats().samples;
   summary["samples_by_type"] = reader.stats().samples_by_type;
   summary["skipped_lines_by_reason"] = reader.stats().skipped_by_reason;
+  summary["samples_reordered"] = {{"samples", reader.stats().reordered}, {"window_s", reader.stats().reorder_window_s}};
   summary["not_used"] = reader.stats().not_used;
   nlohmann::json issues = nlohmann::json::array();
   for (const auto& i : reader.stats().issues) issues.push_back(i.to_string());
@@ -173,6 +174,9 @@ int run_replay(const ReplayArgs& a) {
   for (const auto& [type, n] : reader.stats().samples_by_type) std::cout << "  " << type << ": " << n << "\n";
   for (const auto& [why, n] : reader.stats().skipped_by_reason) std::cout << "  skipped " << n << ": " << why << "\n";
   print_not_used(std::cout, reader.stats());
+  if (reader.stats().reordered > 0)
+    std::cout << "  reordered " << reader.stats().reordered << ": motion-sensor samples read in time order, not file order (batched; the latest "
+              << reader.stats().reorder_window_s << " s late)\n";
   {
     // the PDR in one line: what it counted and refused, and whether it thought it rode a vehicle
     const nlohmann::json& p = summary["pdr"];

@@ -3,6 +3,10 @@
 
 #include <algorithm>
 #include <array>
+#include <deque>
+#include <limits>
+#include <map>
+#include <utility>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -64,6 +68,90 @@ class LogSource : public SampleSource {
   bool finished_ = false;
 };
 
+/// Android hands each sensor's FIFO over in turn (batching: SensorManager's maxReportLatency, a
+/// phone's sensor hub), so a log written in arrival order (GnssLogger, GetSensorData) can hold a
+/// gyroscope sample seconds after the accelerometer samples of its time; every consumer reads
+/// the stream as time-ordered (the PDR pairs the gyroscope's attitude and the rotation vector
+/// with each accelerometer sample: the ILC walks with the gyroscope, magnetometer and rotation
+/// vector written 0.1 / 0.3 / 1 s late went 2.43 -> 2.49 / 2.70 / 3.06 m). The motion-sensor
+/// samples pass through a buffer as wide as the largest lateness seen so far (at most
+/// kMaxReorderS; later than that, as they come) and leave it in time order; every other sample
+/// (GNSS, fixes, truth, meta: clocks that may differ) keeps its place in the motion timeline as
+/// it came (after the motion samples up to the newest one read before it). A log in time order
+/// passes through unchanged.
+class MotionInTimeOrder : public SampleSource {
+ public:
+  static constexpr double kMaxReorderS = 5.0;
+  explicit MotionInTimeOrder(std::unique_ptr<SampleSource> inner) : inner_(std::move(inner)), stats_(inner_->stats()) {}
+  bool next(Sample& out) override {
+    while (ready_.empty()) {
+      Sample s;
+      if (!inner_->next(s)) {
+        release(std::numeric_limits<TimeNs>::max());
+        if (ready_.empty()) return false;
+        break;
+      }
+      if (!is_motion(s)) {  // stays where it came in the motion timeline (its clock may differ)
+        buf_.emplace(std::make_pair(have_newest_ ? newest_ : std::numeric_limits<TimeNs>::min(), seq_++), std::move(s));
+        release(have_newest_ ? horizon() : std::numeric_limits<TimeNs>::max());
+        continue;
+      }
+      const TimeNs t = sample_time_ns(s);
+      // (in double first: a malformed time must not overflow the difference)
+      if (have_newest_ && t < newest_ && (static_cast<double>(newest_) - static_cast<double>(t)) * 1e-9 <= kMaxReorderS)
+        window_ = std::max(window_, newest_ - t);
+      if (!have_newest_ || t > newest_) newest_ = t, have_newest_ = true;
+      buf_.emplace(std::make_pair(t, seq_++), std::move(s));
+      release(horizon());
+    }
+    out = std::move(ready_.front());
+    ready_.pop_front();
+    return true;
+  }
+  const ReadStats& stats() const override {
+    stats_ = inner_->stats();
+    stats_.reordered = reordered_;
+    stats_.reorder_window_s = ns_to_s(window_);
+    return stats_;
+  }
+  double progress() const override { return inner_->progress(); }
+  const std::string& name() const override { return inner_->name(); }
+  const std::map<std::string, std::string>& header_info() const override { return inner_->header_info(); }
+  Format format() const override { return inner_->format(); }
+
+ private:
+  static bool is_motion(const Sample& s) {
+    return std::holds_alternative<AccelSample>(s) || std::holds_alternative<GyroSample>(s) ||
+           std::holds_alternative<MagSample>(s) || std::holds_alternative<UncalAccelSample>(s) ||
+           std::holds_alternative<UncalGyroSample>(s) || std::holds_alternative<UncalMagSample>(s) ||
+           std::holds_alternative<RotationVectorSample>(s) || std::holds_alternative<GameRotationVectorSample>(s) ||
+           std::holds_alternative<StepDetectorSample>(s) || std::holds_alternative<PressureSample>(s);
+  }
+  /// The time up to which the buffer is complete: newest - window (saturating).
+  TimeNs horizon() const {
+    return newest_ < std::numeric_limits<TimeNs>::min() + window_ ? std::numeric_limits<TimeNs>::min() : newest_ - window_;
+  }
+  /// Every buffered sample at or before t, in time order (file order among equal times).
+  void release(TimeNs t) {
+    while (!buf_.empty() && buf_.begin()->first.first <= t) {
+      if (buf_.begin()->first.second != next_seq_out_) ++reordered_;  // left the buffer out of file order
+      next_seq_out_ = std::max(next_seq_out_, buf_.begin()->first.second + 1);
+      ready_.push_back(std::move(buf_.begin()->second));
+      buf_.erase(buf_.begin());
+    }
+  }
+  std::unique_ptr<SampleSource> inner_;
+  mutable ReadStats stats_;
+  std::map<std::pair<TimeNs, std::int64_t>, Sample> buf_;  // (time, file order) -> sample
+  std::deque<Sample> ready_;
+  TimeNs newest_ = 0, window_ = 0;
+  bool have_newest_ = false;
+  std::int64_t seq_ = 0, next_seq_out_ = 0, reordered_ = 0;
+};
+
+std::unique_ptr<SampleSource> in_time_order(std::unique_ptr<SampleSource> s) {
+  return std::make_unique<MotionInTimeOrder>(std::move(s));
+}
 
 /// GetSensorData line-type tokens (IPIN competition logfile description).
 bool is_gsd_token(std::string_view t) {
@@ -189,10 +277,10 @@ std::unique_ptr<SampleSource> open_stream_once(const std::string& path, Format f
   switch (fmt) {
     case Format::kSession:
     case Format::kGnssLogger:
-      return std::make_unique<LogSource>(LogReader(std::make_unique<PrefixedStream>(std::move(head), std::move(f)), path, opt.log),
-                                         fmt, opt.require_samples);
+      return in_time_order(std::make_unique<LogSource>(LogReader(std::make_unique<PrefixedStream>(std::move(head), std::move(f)), path, opt.log),
+                                                         fmt, opt.require_samples));
     case Format::kGetSensorData:
-      return detail::open_getsensordata(std::make_unique<PrefixedStream>(std::move(head), std::move(f)), path, 0, opt);
+      return in_time_order(detail::open_getsensordata(std::make_unique<PrefixedStream>(std::move(head), std::move(f)), path, 0, opt));
     case Format::kSensorLogger:
     case Format::kPhyphox:
       return open_memory_source({{name, slurp()}}, path, fmt, opt);
@@ -317,7 +405,7 @@ std::unique_ptr<SampleSource> open_sample_source(const std::string& path, Format
   switch (fmt) {
     case Format::kSession:
     case Format::kGnssLogger:
-      return std::make_unique<LogSource>(LogReader(path, opt.log), fmt, opt.require_samples);
+      return in_time_order(std::make_unique<LogSource>(LogReader(path, opt.log), fmt, opt.require_samples));
     case Format::kSensorLogger:
     case Format::kPhyphox: {
       // one CSV of a recording: read it as a recording of that one file
@@ -326,7 +414,7 @@ std::unique_ptr<SampleSource> open_sample_source(const std::string& path, Format
     case Format::kGetSensorData: {
       auto f = std::make_unique<std::ifstream>(path, std::ios::binary);
       if (!*f) throw IoError(path, 0, std::string("cannot open: ") + std::strerror(errno));
-      return detail::open_getsensordata(std::move(f), path, fs::file_size(path, ec), opt);
+      return in_time_order(detail::open_getsensordata(std::move(f), path, fs::file_size(path, ec), opt));
     }
     case Format::kAuto:
       break;
@@ -346,8 +434,8 @@ std::unique_ptr<SampleSource> open_memory_source(std::vector<std::pair<std::stri
     if (files.size() != 1) throw IoError(name, 0, "a text log is one file");
     auto in = std::make_unique<std::istringstream>(std::move(files[0].second));
     const std::string file = files[0].first;  // messages name the file
-    if (fmt == Format::kGetSensorData) return detail::open_getsensordata(std::move(in), file, 0, opt);
-    return std::make_unique<LogSource>(LogReader(std::move(in), file, opt.log), fmt, opt.require_samples);
+    if (fmt == Format::kGetSensorData) return in_time_order(detail::open_getsensordata(std::move(in), file, 0, opt));
+    return in_time_order(std::make_unique<LogSource>(LogReader(std::move(in), file, opt.log), fmt, opt.require_samples));
   }
   return open_container(detail::open_memory_files(std::move(files), name), fmt, opt);
 }

@@ -45,6 +45,10 @@ struct ReadStats {
   /// Files (or columns) of a multi-file recording that carry nothing the core uses, with why
   /// ("Gravity.csv" -> "gravity alone; TotalAcceleration is read"). Not skipped lines.
   std::map<std::string, std::string> not_used;
+  /// Motion-sensor samples a log written in arrival order held after later ones of another
+  /// sensor, released in time order (open_sample_source), and the widest lateness seen, s.
+  std::int64_t reordered = 0;
+  double reorder_window_s = 0.0;
   std::int64_t skipped_total() const;
 };
 
