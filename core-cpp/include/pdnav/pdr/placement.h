@@ -179,8 +179,8 @@ class PlacementEstimator {
   double var_v_ = 0.0, n_corr_ = 0.0;
   Eigen::Matrix3d cov_h_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d cov_w_ = Eigen::Matrix3d::Zero();  // levelled gait-band angular rate, walking (phone axes)
-  Eigen::Vector3d sum_up_walk_ = Eigen::Vector3d::Zero();
-  double swing_sq_ = 0.0, swing_n_ = 0.0;  // tilt swing while walking (PlacementBout::tilt_swing_deg)  // tilt filter's up while walking (phone axes)
+  Eigen::Vector3d sum_up_walk_ = Eigen::Vector3d::Zero();  // tilt filter's up while walking (phone axes)
+  double swing_sq_ = 0.0, swing_n_ = 0.0;  // tilt swing while walking (PlacementBout::tilt_swing_deg)
   Eigen::Vector3d w_hp_in_ = Eigen::Vector3d::Zero(), w_hp_out_ = Eigen::Vector3d::Zero();
   TimeNs w_hp_ns_ = -1;
   double walking_s_ = 0.0;
