@@ -195,6 +195,7 @@ void Pdr::feed(const AccelSample& s) {
   detector_.set_running(opt_.gate_handling && classifier_.running());
   auto candidates = detector_.feed(s);
   forward_candidates(s, candidates);
+  for (const auto& c : candidates) placement_.set_step_interval(c.interval_s);  // the step band's cadence
   if (detector_.counters().gaps != gaps_seen_) {  // a gap resets the detector and the bout
     gaps_seen_ = detector_.counters().gaps;
     release(gate_.end_bout(), s.t_ns);

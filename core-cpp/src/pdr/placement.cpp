@@ -34,6 +34,9 @@ void PlacementEstimator::start_bout(TimeNs t_ns) {
   bout_up_ = up_;
   corr_.setZero();
   cov_h_.setZero();
+  corr_band_.setZero();
+  cov_h_band_.setZero();
+  var_v_band_ = band_walking_s_ = 0.0;
   cov_w_.setZero();
   sum_up_walk_.setZero();
   var_v_ = n_corr_ = walking_s_ = swing_sq_ = swing_n_ = 0.0;
@@ -139,16 +142,29 @@ void PlacementEstimator::feed(const AccelSample& s, bool walking) {
   const bool level = tilt_ok_ && bout_.placement != Placement::kFlat;
   if (walking) bout_levelled_ = level;
   const Eigen::Vector3d& u = level ? tilt_up_ : up_;
-  const Eigen::Vector3d lin = gait_band(level ? Eigen::Vector3d(s.acc_mps2 - mean.norm() * u) : Eigen::Vector3d(s.acc_mps2 - mean), dt);
+  const Eigen::Vector3d raw_lin = level ? Eigen::Vector3d(s.acc_mps2 - mean.norm() * u) : Eigen::Vector3d(s.acc_mps2 - mean);
+  const Eigen::Vector3d lin = gait_band(raw_lin, dt);
   const double av = lin.dot(u);
   const Eigen::Vector3d h = lin - av * u;
-  hist_.emplace_back(s.t_ns, h);
+  // the same about the step frequency, once the cadence is known and the band has settled
+  const Eigen::Vector3d lin_band = step_band(raw_lin, dt);
+  const double f_step = step_frequency_hz();
+  const bool band = f_step > 0.0 && bp_settle_s_ >= 2.0 / f_step;
+  const double av_band = lin_band.dot(u);
+  hist_.push_back({s.t_ns, h, lin_band - av_band * u, band});
   const TimeNs lag_t = s.t_ns - s_to_ns(opt_.phase_lag_s);
-  while (hist_.size() > 1 && hist_[1].first <= lag_t) hist_.pop_front();
-  if (walking && hist_.front().first <= lag_t && ns_to_s(lag_t - hist_.front().first) < 0.05) {
-    const Eigen::Vector3d& hl = hist_.front().second;
+  while (hist_.size() > 1 && hist_[1].t_ns <= lag_t) hist_.pop_front();
+  if (walking && hist_.front().t_ns <= lag_t && ns_to_s(lag_t - hist_.front().t_ns) < 0.05) {
+    const Eigen::Vector3d& hl = hist_.front().h;
     corr_ += av * hl;
     cov_h_ += hl * hl.transpose();
+    if (band && hist_.front().band) {
+      const Eigen::Vector3d& bl = hist_.front().h_band;
+      corr_band_ += av_band * bl;
+      cov_h_band_ += bl * bl.transpose();
+      var_v_band_ += av_band * av_band;
+      band_walking_s_ += dt;
+    }
     if (level) {  // the horizontal part of the gait-band angular rate about the instantaneous gravity
       const Eigen::Vector3d w_h = w_hp_out_ - w_hp_out_.dot(tilt_up_) * tilt_up_;
       cov_w_ += w_h * w_h.transpose();
@@ -191,9 +207,50 @@ Eigen::Vector3d PlacementEstimator::gait_band(const Eigen::Vector3d& lin, double
   return hp_out_;
 }
 
+void PlacementEstimator::set_step_interval(double interval_s) {
+  if (!(interval_s >= 0.2 && interval_s <= 1.2)) return;
+  step_intervals_s_.push_back(interval_s);
+  if (step_intervals_s_.size() > 5) step_intervals_s_.pop_front();
+}
+
+double PlacementEstimator::step_frequency_hz() const {
+  if (!(opt_.step_band_q > 0.0) || step_intervals_s_.empty()) return 0.0;
+  std::vector<double> v(step_intervals_s_.begin(), step_intervals_s_.end());
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return 1.0 / *mid;
+}
+
+Eigen::Vector3d PlacementEstimator::step_band(const Eigen::Vector3d& x, double dt_s) {
+  const double f0 = step_frequency_hz();
+  // no cadence yet, first sample or a gap, or the step frequency near Nyquist: restart
+  if (!(f0 > 0.0) || !(dt_s > 0.0) || dt_s > 0.5 || f0 * dt_s >= 0.25) {
+    bp_x1_ = bp_x2_ = x;
+    bp_y1_.setZero();
+    bp_y2_.setZero();
+    bp_settle_s_ = 0.0;
+    return Eigen::Vector3d::Zero();
+  }
+  // RBJ audio-EQ cookbook band-pass, 0 dB peak gain, at the sample's own interval
+  const double w0 = 2.0 * kPi * f0 * dt_s;
+  const double alpha = std::sin(w0) / (2.0 * opt_.step_band_q);
+  const double a0 = 1.0 + alpha;
+  const Eigen::Vector3d y = (alpha * x - alpha * bp_x2_ + 2.0 * std::cos(w0) * bp_y1_ - (1.0 - alpha) * bp_y2_) / a0;
+  bp_x2_ = bp_x1_;
+  bp_x1_ = x;
+  bp_y2_ = bp_y1_;
+  bp_y1_ = y;
+  bp_settle_s_ += dt_s;
+  return y;
+}
+
 void PlacementEstimator::update_forward() {
   const bool trusted = walking_s_ >= opt_.min_bout_s && var_v_ > 0.0;
-  Eigen::Vector3d d = corr_ - corr_.dot(up_) * up_;  // the motion's direction (horizontal)
+  // the motion's direction (horizontal): from the step band once it has min_bout_s of walking
+  // (the medio-lateral sway at the stride frequency filtered out), else the broadband correlation
+  const bool band = band_walking_s_ >= opt_.min_bout_s && var_v_band_ > 0.0;
+  const Eigen::Vector3d& c_dir = band ? corr_band_ : corr_;
+  Eigen::Vector3d d = c_dir - c_dir.dot(up_) * up_;
   // the limb-carry evidence, once per update (an eigen-decomposition, per walking sample)
   const std::optional<Eigen::Vector3d> axis_forward = trusted ? rotation_axis_forward() : std::nullopt;
   if (bout_.placement == Placement::kUpright) {
@@ -229,8 +286,8 @@ void PlacementEstimator::update_forward() {
     d.normalize();
     if (axis_forward) d = axis_forward->dot(d) >= 0.0 ? *axis_forward : Eigen::Vector3d(-*axis_forward);
     bout_.forward_phone = d;
-    const double vf = d.dot(cov_h_ * d);
-    bout_.phase_corr = vf > 0.0 ? d.dot(corr_) / std::sqrt(var_v_ * vf) : 0.0;
+    const double vf = d.dot((band ? cov_h_band_ : cov_h_) * d);
+    bout_.phase_corr = vf > 0.0 ? d.dot(c_dir) / std::sqrt((band ? var_v_band_ : var_v_) * vf) : 0.0;
   } else {
     bout_.forward_phone = reference_;
     bout_.phase_corr = 0.0;

@@ -62,6 +62,14 @@ struct PlacementOptions {
   double change_hold_s = 1.5;          // ... for this long: a new placement bout
   double phase_lag_s = 0.14;           // a quarter of a 0.55 s step (1.8 Hz cadence)
   double gait_highpass_hz = 0.6;       // first-order high-pass of the linear acceleration (0 = off)
+  // Once the walker's cadence is known (set_step_interval), the linear acceleration entering the
+  // phase correlation is band-passed about the step frequency instead (a second-order band-pass
+  // of this Q: 1.41 = one octave, 0.71-1.41 x the step frequency): the anterior-posterior
+  // acceleration and its lead over the vertical live at the step frequency, the medio-lateral
+  // sway at the stride frequency, half of it (Kourogi & Kurata, "A method of pedestrian dead
+  // reckoning for smartphones using frequency domain analysis on patterns of acceleration and
+  // angular velocity", IEEE/ION PLANS 2014). 0 = off (the high-pass throughout).
+  double step_band_q = 1.41;
   double flip_corr = -0.25;            // flat/upright prior reversed only below this correlation
   double flip_settle_s = 4.0;          // ... after this much walking; before, below flip_corr sqrt(settle / t)
   double min_bout_s = 2.0;             // correlation trusted after this much walking in a bout
@@ -111,6 +119,11 @@ class PlacementEstimator {
   void feed(const GyroSample& s);
   /// Ends the current bout (e.g. the phone was handled); the next sample starts a new one.
   void end_bout();
+  /// A step interval (s) from the step detector: the step band follows the walker's cadence
+  /// (median of the latest five; values outside 0.2-1.2 s are ignored).
+  void set_step_interval(double interval_s);
+  /// The step frequency the band is tuned to (Hz), 0 before any step interval.
+  double step_frequency_hz() const;
 
   bool ready() const { return have_up_; }
   /// A placement bout is open (false before the first and between a handling span and the next).
@@ -152,6 +165,8 @@ class PlacementEstimator {
   void start_bout(TimeNs t_ns);
   void update_forward();
   Eigen::Vector3d gait_band(const Eigen::Vector3d& lin, double dt_s);
+  // the band-pass about the step frequency (RBJ biquad, direct form I, coefficients per sample)
+  Eigen::Vector3d step_band(const Eigen::Vector3d& lin, double dt_s);
   // the walking direction from the dominant horizontal gait rotation axis (unsigned), if any
   std::optional<Eigen::Vector3d> rotation_axis_forward() const;
   double flip_threshold() const;
@@ -172,9 +187,22 @@ class PlacementEstimator {
   std::int64_t revision_ = 0;
   Eigen::Vector3d reference_ = Eigen::Vector3d::UnitY();
   // lagged correlation: vertical now x horizontal tau ago (phone axes)
-  std::deque<std::pair<TimeNs, Eigen::Vector3d>> hist_;  // (t, horizontal linear acceleration)
+  struct Lagged {
+    TimeNs t_ns;
+    Eigen::Vector3d h;       // horizontal linear acceleration (gait band)
+    Eigen::Vector3d h_band;  // ... about the step frequency
+    bool band;               // the step band was settled
+  };
+  std::deque<Lagged> hist_;
+  Eigen::Vector3d corr_band_ = Eigen::Vector3d::Zero();  // the lagged correlation in the step band
+  Eigen::Matrix3d cov_h_band_ = Eigen::Matrix3d::Zero();
+  double var_v_band_ = 0.0, band_walking_s_ = 0.0;
   Eigen::Vector3d corr_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d hp_in_ = Eigen::Vector3d::Zero(), hp_out_ = Eigen::Vector3d::Zero();
+  std::deque<double> step_intervals_s_;  // the latest step intervals (set_step_interval)
+  Eigen::Vector3d bp_x1_ = Eigen::Vector3d::Zero(), bp_x2_ = Eigen::Vector3d::Zero();  // band-pass inputs
+  Eigen::Vector3d bp_y1_ = Eigen::Vector3d::Zero(), bp_y2_ = Eigen::Vector3d::Zero();  // ... and outputs
+  double bp_settle_s_ = 0.0;  // time the band-pass has run since its last restart
   bool reversed_ = false;  // the bout's prior axis has been reversed
   double var_v_ = 0.0, n_corr_ = 0.0;
   Eigen::Matrix3d cov_h_ = Eigen::Matrix3d::Zero();
