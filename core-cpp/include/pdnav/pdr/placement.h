@@ -28,6 +28,7 @@
 // One constant offset per placement bout; a bout ends when the gravity direction in phone
 // axes moves by more than change_angle_rad for change_hold_s (the phone was moved).
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <deque>
 #include <optional>
@@ -148,7 +149,8 @@ class PlacementEstimator {
     if (!in_bout_) return false;
     // no prior axis (placement "other"): the direction is the correlation itself, trusted at min_bout_s
     if (!prior_applies()) return walking_s_ >= opt_.min_bout_s;
-    if (prior_supported_) return walking_s_ >= opt_.prior_confirm_s;
+    if (prior_supported_)
+      return walking_s_ >= (bout_.placement == Placement::kUpright ? std::max(opt_.prior_confirm_s, opt_.prior_check_s) : opt_.prior_confirm_s);
     // the motion contradicts the prior: known once reversed, or once the evidence has settled
     return walking_s_ >= opt_.flip_settle_s || (walking_s_ >= opt_.min_bout_s && reversed_);
   }
