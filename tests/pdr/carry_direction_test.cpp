@@ -415,3 +415,41 @@ TEST(PdrCarryDirection, AtTheEarTheStepBandHoldsTheWalkingDirectionThroughTheWal
     EXPECT_LT(band_sum, 0.6 * broad_sum);
   }
 }
+
+TEST(PdrCarryDirection, StepsOutBeforeTheirDirectionIsDecidedSaySo) {
+  // The running pocket with its magnetometer (a compass heading, so the steps' heading sigma is
+  // the fusion's few degrees): twice the phone settles in the pocket after the run has begun,
+  // and steps wait max_direction_wait_s for the bout's direction in vain. They go out with the
+  // prior axis, and their heading sigma is the undecided direction's
+  // (PlacementOptions::undecided_direction_sigma_rad); every other step keeps the heading's own.
+  const std::string name = "Guillaume_Nexus5_NoDist_RunningPocket";
+  const Recording r = read_tyrex(name);
+  std::vector<MagSample> mag;
+  read_txyz(pdnav::test::shared_data("pdr-tyrex-guillaume/datasets/android/" + name) + "/magnetometer-calibrated.txt",
+            [&](TimeNs t, const Eigen::Vector3d& v) { mag.push_back({t, kMissingInt, v}); });
+  PdrOptions o;
+  o.heading.mount = Mount::kAuto;
+  Pdr pdr(o);
+  std::size_t g = 0, m = 0;
+  for (const auto& a : r.accel) {
+    while (g < r.gyro.size() && r.gyro[g].t_ns <= a.t_ns) pdr.feed(r.gyro[g++]);
+    while (m < mag.size() && mag[m].t_ns <= a.t_ns) pdr.feed(mag[m++]);
+    pdr.feed(a);
+  }
+  pdr.finish();
+  const double undecided = PlacementOptions{}.undecided_direction_sigma_rad;
+  int wide = 0, total = 0;
+  double max_other_deg = 0.0;
+  for (const PdrStep& st : pdr.take_steps()) {
+    ++total;
+    if (st.heading_sigma_rad >= undecided) ++wide;
+    else max_other_deg = std::max(max_other_deg, st.heading_sigma_rad / kDegToRad);
+  }
+  const std::int64_t counted = pdr.counters().steps_with_undecided_direction;
+  std::printf("running pocket: %d of %d steps out with an undecided direction (counter %lld); the others' heading "
+              "sigma at most %.1f deg\n", wide, total, static_cast<long long>(counted), max_other_deg);
+  EXPECT_EQ(wide, counted);
+  EXPECT_GE(counted, 5);
+  EXPECT_LT(counted, total / 5);
+  EXPECT_LT(max_other_deg, 45.0);
+}

@@ -332,6 +332,7 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
   j["steps_from_handling_hangover"] = c.steps_from_handling_hangover;
   j["forward_channel_candidates"] = c.forward_channel_candidates;
   j["steps_before_their_bouts_direction"] = c.steps_before_their_bouts_direction;
+  j["steps_with_undecided_direction"] = c.steps_with_undecided_direction;
   j["steps_refused_vehicle"] = c.steps_discarded_by_vehicle;
   j["max_step_delay_s"] = c.max_step_delay_s;  // longest step-to-emission latency
   j["max_step_delay_at_s"] = c.max_step_delay_s > 0.0 ? ns_to_s(c.max_step_delay_at_ns - t0_ns) : 0.0;

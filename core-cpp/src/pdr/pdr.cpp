@@ -444,7 +444,17 @@ void Pdr::emit_walking(const HeldStep& h) {
   // out before its own bout began (the wait ran out): it carries the previous bout's direction
   if (opt_.heading.mount == Mount::kAuto && h.placement_revision > placement_.revision())
     ++counters_.steps_before_their_bouts_direction;
-  emit_step(reprojected(h));
+  HeldStep out = reprojected(h);
+  // out before its bout's walking direction is decided (the wait ran out): the direction is the
+  // placement's prior or the previous bout's, and the step's heading sigma says so
+  const bool undecided = opt_.heading.mount == Mount::kAuto &&
+                         (h.placement_revision > placement_.revision() ||
+                          (h.placement_revision == placement_.revision() && !placement_.direction_known()));
+  if (undecided) {
+    out.heading_sigma_rad = std::max(out.heading_sigma_rad, opt_.placement.undecided_direction_sigma_rad);
+    ++counters_.steps_with_undecided_direction;
+  }
+  emit_step(out);
 }
 
 void Pdr::flush_undecided(TimeNs now_ns, bool force) {

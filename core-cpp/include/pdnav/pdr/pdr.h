@@ -118,6 +118,9 @@ struct PdrCounters {
   /// Steps emitted before the placement bout they belong to had begun (its walking direction
   /// was waited for max_direction_wait_s in vain): they carry the previous bout's direction.
   std::int64_t steps_before_their_bouts_direction = 0;
+  // steps out before their bout's walking direction was decided (the wait ran out): heading sigma
+  // at least PlacementOptions::undecided_direction_sigma_rad
+  std::int64_t steps_with_undecided_direction = 0;
   std::int64_t mag_readings_trusted = 0;       // absolute headings that passed the WMM tests
   std::int64_t mag_readings_disturbed = 0;     // ... and that failed them (down-weighted)
   std::int64_t mag_readings_qsf_tested = 0;    // magnetometer readings tested for a quasi-static field
