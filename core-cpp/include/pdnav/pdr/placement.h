@@ -147,9 +147,11 @@ class PlacementEstimator {
   /// forward_phone() under the current gravity; 0 when either is near vertical.
   double forward_offset_rad() const;
   /// The walking direction of the current bout is decided: without a prior axis ("other"), after
-  /// min_bout_s of walking; with one, the motion supports it
-  /// (after prior_confirm_s), or it contradicts it and the prior has been reversed (after
-  /// min_bout_s) or the evidence has settled (flip_settle_s) without a reversal.
+  /// min_bout_s of walking; with one, the motion supports it (a flat phone's sign after
+  /// prior_confirm_s; an upright phone's line, tested after prior_check_s: at the ear or in a
+  /// trouser pocket it is upright too and walks along +-X), or it contradicts it and the prior
+  /// has been reversed (after min_bout_s) or the evidence has settled (flip_settle_s) without a
+  /// reversal.
   bool direction_known() const {
     if (!in_bout_) return false;
     // no prior axis (placement "other"): the direction is the correlation itself, trusted at min_bout_s
