@@ -91,7 +91,16 @@ class MotionInTimeOrder : public SampleSource {
         if (ready_.empty()) return false;
         break;
       }
-      if (!is_motion(s)) {  // stays where it came in the motion timeline (its clock may differ)
+      // In order so far (no lateness seen, nothing held) and not late itself: it would enter the
+      // buffer and leave it at once, so it goes out directly (every sample of a time-ordered log)
+      const bool motion = is_motion(s);
+      if (buf_.empty() && window_ == 0 && (!motion || !have_newest_ || sample_time_ns(s) >= newest_)) {
+        if (motion) newest_ = sample_time_ns(s), have_newest_ = true;
+        next_seq_out_ = ++seq_;
+        out = std::move(s);
+        return true;
+      }
+      if (!motion) {  // stays where it came in the motion timeline (its clock may differ)
         buf_.emplace(std::make_pair(have_newest_ ? newest_ : std::numeric_limits<TimeNs>::min(), seq_++), std::move(s));
         release(have_newest_ ? horizon() : std::numeric_limits<TimeNs>::max());
         continue;
