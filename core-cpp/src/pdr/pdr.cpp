@@ -425,14 +425,17 @@ void Pdr::settle_vehicle_wait(TimeNs now_ns, bool force) {
   }
 }
 
+bool Pdr::direction_pending(const HeldStep& h) const {
+  return opt_.heading.mount == Mount::kAuto &&
+         (h.placement_revision > placement_.revision() ||
+          (h.placement_revision == placement_.revision() && !placement_.direction_known()));
+}
+
 void Pdr::deliver_walking(HeldStep h, TimeNs now_ns) {
   // A step of the current bout waits for the bout's walking direction, and so does a step taken
   // before its bout started (hold(): it belongs to the next bout): going out now it would take
   // the previous bout's direction, which the phone moved since (a handling ends a bout).
-  const bool wait = opt_.heading.mount == Mount::kAuto && opt_.placement.max_direction_wait_s > 0.0 &&
-                    (h.placement_revision > placement_.revision() ||
-                     (h.placement_revision == placement_.revision() && !placement_.direction_known()));
-  if (wait) {
+  if (opt_.placement.max_direction_wait_s > 0.0 && direction_pending(h)) {
     undecided_.push_back(h);
     return;
   }
@@ -447,10 +450,7 @@ void Pdr::emit_walking(const HeldStep& h) {
   HeldStep out = reprojected(h);
   // out before its bout's walking direction is decided (the wait ran out): the direction is the
   // placement's prior or the previous bout's, and the step's heading sigma says so
-  const bool undecided = opt_.heading.mount == Mount::kAuto &&
-                         (h.placement_revision > placement_.revision() ||
-                          (h.placement_revision == placement_.revision() && !placement_.direction_known()));
-  if (undecided) {
+  if (direction_pending(h)) {
     out.heading_sigma_rad = std::max(out.heading_sigma_rad, opt_.placement.undecided_direction_sigma_rad);
     ++counters_.steps_with_undecided_direction;
   }

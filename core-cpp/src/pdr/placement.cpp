@@ -208,17 +208,14 @@ Eigen::Vector3d PlacementEstimator::gait_band(const Eigen::Vector3d& lin, double
 }
 
 void PlacementEstimator::set_step_interval(double interval_s) {
-  if (!(interval_s >= 0.2 && interval_s <= 1.2)) return;
+  if (!(opt_.step_band_q > 0.0) || !(interval_s >= 0.2 && interval_s <= 1.2)) return;
   step_intervals_s_.push_back(interval_s);
   if (step_intervals_s_.size() > 5) step_intervals_s_.pop_front();
-}
-
-double PlacementEstimator::step_frequency_hz() const {
-  if (!(opt_.step_band_q > 0.0) || step_intervals_s_.empty()) return 0.0;
+  // the band's frequency changes only here: the median interval, once per step
   std::vector<double> v(step_intervals_s_.begin(), step_intervals_s_.end());
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
-  return 1.0 / *mid;
+  step_frequency_hz_ = 1.0 / *mid;
 }
 
 Eigen::Vector3d PlacementEstimator::step_band(const Eigen::Vector3d& x, double dt_s) {

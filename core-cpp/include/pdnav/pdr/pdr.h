@@ -252,6 +252,9 @@ class Pdr {
   /// still the prior (first steps); the held ones are re-projected when it is decided.
   void deliver(HeldStep h, TimeNs now_ns);
   void deliver_walking(HeldStep h, TimeNs now_ns);
+  /// The step's placement bout has not decided its walking direction yet (auto mount): it began
+  /// after the step's (the step is ahead of its bout) or it is the current one, undecided.
+  bool direction_pending(const HeldStep& h) const;
   /// Steps held while vehicle evidence accumulates: dropped inside a vehicle span, delivered
   /// once the evidence is gone (or at the end of the input).
   void settle_vehicle_wait(TimeNs now_ns, bool force);

@@ -129,7 +129,7 @@ class PlacementEstimator {
   /// (median of the latest five; values outside 0.2-1.2 s are ignored).
   void set_step_interval(double interval_s);
   /// The step frequency the band is tuned to (Hz), 0 before any step interval.
-  double step_frequency_hz() const;
+  double step_frequency_hz() const { return step_frequency_hz_; }
 
   bool ready() const { return have_up_; }
   /// A placement bout is open (false before the first and between a handling span and the next).
@@ -209,6 +209,7 @@ class PlacementEstimator {
   Eigen::Vector3d corr_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d hp_in_ = Eigen::Vector3d::Zero(), hp_out_ = Eigen::Vector3d::Zero();
   std::deque<double> step_intervals_s_;  // the latest step intervals (set_step_interval)
+  double step_frequency_hz_ = 0.0;       // 1 / their median (0: none yet, or the band is off)
   Eigen::Vector3d bp_x1_ = Eigen::Vector3d::Zero(), bp_x2_ = Eigen::Vector3d::Zero();  // band-pass inputs
   Eigen::Vector3d bp_y1_ = Eigen::Vector3d::Zero(), bp_y2_ = Eigen::Vector3d::Zero();  // ... and outputs
   double bp_settle_s_ = 0.0;  // time the band-pass has run since its last restart
