@@ -1,9 +1,9 @@
 #!/usr/bin/python3
 """`pdnav eval-outage` on a simulated phone session with GNSS throughout (issue 28):
 (1) the last line is the bar line and the per-walk lines are printed; (2) the window is where
-the options put it and the GNSS rows in it were removed; (3) the figures are within bounds
-(fused beats dead reckoning restarted at the last fix, the fused 68 % region holds the truth
-about as often as it says, no jump beyond 3 sigma when GNSS returns); (4) the per-walk CSV
+the options put it and the GNSS rows in it were removed; (3) the figures are within bounds on six
+sessions pooled (fused beats dead reckoning restarted at the last fix, the fused 68 % region
+holds the truth about as often as it says, no jump beyond 3 sigma when GNSS returns); (4) the per-walk CSV
 and JSON exist and agree with the printed figures; (5) dead reckoning starts at the last fix;
 (6) bad input is a clear error: a log without any reference, a window outside the GNSS span.
 
@@ -45,21 +45,36 @@ def main(argv):
     m = BAR.fullmatch(lines[-1])
     if not m:
         sys.exit(f"FAIL: last line is not the bar line: {lines[-1]!r}")
-    ratio, rms, cov, jump = (float(x) for x in m.groups()[:4])
+    ratio, rms, cov, _jump = (float(x) for x in m.groups()[:4])
     walks = int(m.group(5))
     if walks != 1:
         failures.append(f"walks {walks} != 1")
     if "eval-outage" not in r.stderr:
         failures.append("no progress on stderr")
-    # bounds on this seed (truth reference; measured 0.411 / 8.2 m / 0.837 / 0.174): the issue's bars
-    if not (0.0 < ratio <= 0.5):
-        failures.append(f"outage_ratio {ratio} not in (0, 0.5]")
-    if not (0.5 <= cov <= 0.9):
-        failures.append(f"coverage_68 {cov} not in [0.5, 0.9]")
-    if not (0.0 <= jump <= 3.0):
-        failures.append(f"max_jump_sigma {jump} not in [0, 3]")
     if not (0.1 < rms < 30.0):
         failures.append(f"outage_rms_m {rms} not in (0.1, 30)")
+    # the issue's bars, on six sessions (seeds 11-16) pooled as eval-outage pools them: one walk's
+    # coverage is one route match early or late (seed 11 alone: 0.83, or 0.48 with a GNSS KF whose
+    # covariance was 30 % tighter before the window, docs/results.md)
+    logs = [log]
+    for seed in range(12, 17):
+        logs.append(os.path.join(scratch, f"session{seed}.log"))
+        run([pdnav, "simulate", "--session", "--dem", dem, "--graph", graph, "--nav", nav, "-o", logs[-1], "--seed",
+             str(seed), "--lead", "240", "--outage-min", "0", "--outage-max", "0", "--tail", "240"])
+    rp = run([pdnav, "eval-outage", *logs, "--nav", nav, "--dem", dem, "--graph", graph, "--mount", "chest",
+              "--start-frac", "0.4", "--length-frac", "0.4", "--max-s", "300", "--quiet"])
+    print(rp.stdout, end="")
+    mp = BAR.fullmatch(rp.stdout.rstrip("\n").split("\n")[-1])
+    if not mp or int(mp.group(5)) != 6:
+        sys.exit(f"FAIL: six sessions: no bar line with walks: 6: {rp.stdout[-300:]}")
+    p_ratio, _p_rms, p_cov, p_jump = (float(x) for x in mp.groups()[:4])
+    # measured 0.249 / 4.3 m / 0.870 / 0.629 (6 sessions, truth reference)
+    if not (0.0 < p_ratio <= 0.5):
+        failures.append(f"six sessions: outage_ratio {p_ratio} not in (0, 0.5]")
+    if not (0.5 <= p_cov <= 0.9):
+        failures.append(f"six sessions: coverage_68 {p_cov} not in [0.5, 0.9]")
+    if not (0.0 <= p_jump <= 3.0):
+        failures.append(f"six sessions: max_jump_sigma {p_jump} not in [0, 3]")
     w = re.search(r"window (\d+)-(\d+) s \((\d+) epochs; removed (\d+) Raw, (\d+) Fix rows\)", r.stdout)
     span = re.search(r"GNSS span (\d+) s", r.stdout)
     if not w or not span:
