@@ -43,6 +43,7 @@ struct GnssArgs {
   std::string residuals_out;
   bool strip_adr = false;
   double smoothing_window_s = gnss::SmoothingOptions{}.window_s;
+  bool smoothed_white_noise = gnss::GnssOptions{}.smoothed_code_white_noise;
   std::uint64_t seed = 1;
   int keep_every = 1;  // robustness check: keep every N-th epoch (duty cycling)
   bool clock_steps = false;  // robustness check: a 1 ms code-only clock step every epoch
@@ -268,7 +269,7 @@ void write_residuals(const std::string& path, const std::vector<gnss::EpochSolut
   const gnss::TruthTrack track = have_static ? gnss::TruthTrack() : gnss::read_truth_csv_file(a.truth_csv);
   std::ofstream f(path);
   if (!f) throw std::runtime_error(path + ": cannot write");
-  f << "gps_ns,sys,svid,band,cn0_dbhz,el_deg,raw_m,smoothed_m,group_size,iono_free,az_deg\n";
+  f << "gps_ns,sys,svid,band,cn0_dbhz,el_deg,raw_m,smoothed_m,group_size,iono_free,az_deg,white_ratio\n";
   std::int64_t rows = 0, epochs = 0;
   for (const gnss::EpochSolution& s : sols) {
     if (s.code_obs.empty()) continue;
@@ -287,14 +288,18 @@ void write_residuals(const std::string& path, const std::vector<gnss::EpochSolut
     std::map<gnss::SatId, double> smoothed;
     for (const auto& r : r_sm) smoothed[r.sat] = r.residual_m;
     std::map<gnss::SatId, bool> iono_free;
-    for (const auto& o : s.code_obs) iono_free[o.sat] = o.iono_free;
+    std::map<gnss::SatId, double> white_ratio;
+    for (const auto& o : s.code_obs) {
+      iono_free[o.sat] = o.iono_free;
+      white_ratio[o.sat] = o.white_var_ratio;
+    }
     for (const auto& r : r_raw) {
       const auto it = smoothed.find(r.sat);
       char line[256];
-      std::snprintf(line, sizeof line, "%lld,%c,%d,%s,%.2f,%.3f,%.4f,%.4f,%d,%d,%.3f\n", static_cast<long long>(s.gps_ns),
+      std::snprintf(line, sizeof line, "%lld,%c,%d,%s,%.2f,%.3f,%.4f,%.4f,%d,%d,%.3f,%.5f\n", static_cast<long long>(s.gps_ns),
                     gnss::rinex_letter(r.sat.sys), r.sat.prn, gnss::to_string(gnss::signal_band(r.carrier_hz)),
                     r.cn0_dbhz, r.el_rad * 180.0 / kPi, r.residual_m, it == smoothed.end() ? kNaN : it->second,
-                    r.group_size, iono_free[r.sat] ? 1 : 0, r.az_rad * 180.0 / kPi);
+                    r.group_size, iono_free[r.sat] ? 1 : 0, r.az_rad * 180.0 / kPi, white_ratio[r.sat]);
       f << line;
       ++rows;
     }
@@ -323,6 +328,7 @@ void run_gnss(const GnssArgs& a) {
   }
   gnss::GnssOptions options;
   options.smoothing.window_s = a.smoothing_window_s;
+  options.smoothed_code_white_noise = a.smoothed_white_noise;
   options.smoothing.iono_window_s = a.iono_window_s;
   options.measurements.dual_min_sats = a.dual_min_sats;
   options.measurements.dual_min_fraction = a.dual_min_fraction;
@@ -405,6 +411,8 @@ void register_gnss(CLI::App& app) {
   cmd->add_flag("--strip-adr", args->strip_adr, "drop carrier phase (tests the Doppler fallback)");
   cmd->add_option("--smoothing-window", args->smoothing_window_s,
                   "carrier smoothing window of the code, s (RTCA DO-229: 100; 0 = raw code)")->check(CLI::Range(0.0, 3600.0));
+  cmd->add_option("--smoothed-white-noise", args->smoothed_white_noise,
+                  "weight a smoothed code by what smoothing left of its C/N0 noise (true, default) or as raw code (false)");
   cmd->add_option("--kf-displacement-q", args->kf_displacement_q_m2,
                   "KF process noise added to each displacement, m^2 per epoch")->check(CLI::Range(0.0, 1e6));
   cmd->add_option("--kf-fix-scale", args->kf_fix_scale, "KF: multiplies the SPP covariance used as R, for fixes 1 s apart (AR(1) over longer gaps)")

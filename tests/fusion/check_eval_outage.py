@@ -54,8 +54,8 @@ def main(argv):
     if not (0.1 < rms < 30.0):
         failures.append(f"outage_rms_m {rms} not in (0.1, 30)")
     # the bars, on six sessions (seeds 11-16) pooled as eval-outage pools them: one walk's
-    # coverage is one route match early or late (seed 11 alone: 0.83, or 0.48 with a GNSS KF whose
-    # covariance was 30 % tighter before the window, docs/results.md)
+    # coverage is one route match early or late (seed 11 alone: 0.83 with the GNSS KF of 80cf665,
+    # 0.48 with today's, 30 % tighter before the window, docs/fusion.md)
     logs = [log]
     for seed in range(12, 17):
         logs.append(os.path.join(scratch, f"session{seed}.log"))
@@ -68,7 +68,7 @@ def main(argv):
     if not mp or int(mp.group(5)) != 6:
         sys.exit(f"FAIL: six sessions: no bar line with walks: 6: {rp.stdout[-300:]}")
     p_ratio, _p_rms, p_cov, p_jump = (float(x) for x in mp.groups()[:4])
-    # measured 0.249 / 4.3 m / 0.870 / 0.629 (6 sessions, truth reference)
+    # measured 0.291 / 4.4 m / 0.795 / 0.653 (6 sessions, truth reference)
     if not (0.0 < p_ratio <= 0.5):
         failures.append(f"six sessions: outage_ratio {p_ratio} not in (0, 0.5]")
     if not (0.5 <= p_cov <= 0.9):

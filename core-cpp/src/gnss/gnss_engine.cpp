@@ -88,6 +88,24 @@ struct GnssEngine::Impl {
     return default_carrier_hz(m.sat.sys, ch);
   }
 
+  /// The white (C/N0) part of the code noise model's variance (the elevation term cancels).
+  double white_code_variance_m2(const Measurement& m, const SatState& st) const {
+    const CodeNoiseModel& nm = opt.spp.code_noise;
+    if (m.iono_free && std::isfinite(m.cn0_l5_dbhz))
+      return iono_free_variance_m2(nm, m.sat.sys, m.cn0_dbhz, m.cn0_l5_dbhz, kPi / 2, 1.0) -
+             iono_free_variance_m2(nm, m.sat.sys, m.cn0_dbhz, m.cn0_l5_dbhz, kPi / 2, 0.0);
+    const double hz = carrier_hz(m, st);
+    return nm.variance_m2(m.sat.sys, hz, m.cn0_dbhz, kPi / 2, 1.0) - nm.variance_m2(m.sat.sys, hz, m.cn0_dbhz, kPi / 2, 0.0);
+  }
+
+  /// The pseudorange rate's variance from its C/N0 (the Doppler velocity's model without a
+  /// reported uncertainty, tdcp.h): RINEX carries no uncertainty, and a log and its RINEX must
+  /// smooth alike.
+  double rate_variance_m2ps2(const Measurement& m) const {
+    const TdcpOptions& t = opt.tdcp;
+    return t.doppler_a_m2ps2 + t.doppler_b_m2ps2 * std::pow(10.0, -m.cn0_dbhz / 10.0);
+  }
+
   /// True when the receiver clock had a hardware discontinuity since the previous epoch.
   bool handle_clock_jump(const MeasurementEpoch& ep) {
     const bool jump =
@@ -132,7 +150,8 @@ struct GnssEngine::Impl {
       if (!sat_state(m, ep.rx, st)) continue;
       if (m.code_ok()) {
         sm_in.push_back(SmoothingInput{m.sat, m.pseudorange_m, m.adr_ok() ? m.adr_m : kNaN, m.pr_rate_mps, m.iono_free,
-                                       m.pseudorange_l1_m, code_band(m.iono_free, m.carrier_hz)});
+                                       m.pseudorange_l1_m, code_band(m.iono_free, m.carrier_hz),
+                                       white_code_variance_m2(m, st), rate_variance_m2ps2(m)});
         spp_obs.push_back(SppObservation{m.sat, m.pseudorange_m, m.cn0_dbhz, carrier_hz(m, st), st, m.iono_free, 1.0,
                                          m.iono_free ? m.cn0_l5_dbhz : kNaN});
       }
@@ -152,6 +171,7 @@ struct GnssEngine::Impl {
       const std::vector<double> sm = smoother.smooth_epoch(sm_in, &why);
       for (std::size_t i = 0; i < sm.size(); ++i) {
         spp_obs[i].pseudorange_m = sm[i];
+        if (opt.smoothed_code_white_noise) spp_obs[i].white_var_ratio = smoother.white_variance_ratio(sm_in[i].sat);
         if (!why[i].empty()) count(why[i]);
       }
       if (smoother.last_common_step_m() != 0.0 && std::fabs(smoother.last_common_step_m()) > 1.0)

@@ -27,13 +27,14 @@ const char* kf_dynamics_name(KfDynamics d) { return d == KfDynamics::kPedestrian
 
 double kf_accel_psd_m2ps3(KfDynamics d) { return d == KfDynamics::kPedestrian ? 1.0 : 10.0; }
 
-double fix_variance_scale_for(const KalmanOptions& opt, double dt_s) {
+double fix_variance_scale_for(const KalmanOptions& opt, double dt_s, double gain) {
   const double s1 = opt.fix_variance_scale;
   if (!(s1 > 1.0)) return std::max(s1, 1e-3);  // no correlation model (or a deliberate shrink)
   const double rho1 = (s1 - 1.0) / (s1 + 1.0);
   const double dt = std::isfinite(dt_s) && dt_s > 0.0 ? dt_s : 1.0;
-  const double rho = std::pow(rho1, dt);
-  return (1.0 + rho) / (1.0 - rho);
+  const double g = std::isfinite(gain) ? std::clamp(gain, 0.0, 1.0) : 0.0;
+  const double a = std::pow(rho1, dt) * (1.0 - g);
+  return (1.0 + a) / (1.0 - a);
 }
 
 double igg3_weight(double t, double k0, double k1) {
@@ -70,6 +71,7 @@ void RobustKalman::reset(const geo::Ecef& pos, const Eigen::Matrix3d& pos_cov, d
   initialized_ = x_.allFinite() && p_.allFinite();
   rejections_in_row_ = 0;
   rejected_span_s_ = 0.0;
+  fix_gain_ = 0.0;
 }
 
 void RobustKalman::predict(const Eigen::Vector3d& disp_m, const Eigen::Matrix3d& disp_cov, double clock_change_m,
@@ -193,7 +195,7 @@ KalmanUpdateResult RobustKalman::update(const geo::Ecef& fix, const Eigen::Matri
   KalmanUpdateResult out;
   if (!fix.p_m.allFinite() || !fix_cov.allFinite() || !std::isfinite(clock_m) || !std::isfinite(clock_var_m2)) return out;
   Eigen::Matrix4d r = Eigen::Matrix4d::Zero();
-  const double scale = fix_variance_scale_for(opt_, since_last_fix_s);
+  const double scale = fix_variance_scale_for(opt_, since_last_fix_s, fix_gain_);
   r.topLeftCorner<3, 3>() = fix_cov * scale;
   for (int i = 0; i < 3; ++i) r(i, i) = std::max(r(i, i), opt_.min_fix_variance_m2);
   r(3, 3) = std::max(clock_var_m2 * scale, opt_.min_fix_variance_m2);
@@ -208,7 +210,13 @@ KalmanUpdateResult RobustKalman::update(const geo::Ecef& fix, const Eigen::Matri
   Eigen::Matrix<double, 4, kStates> h = Eigen::Matrix<double, 4, kStates>::Zero();
   h.block<3, 3>(0, 0).setIdentity();
   h(3, 6) = 1.0;
+  const Eigen::Vector3d prior_var = p_.topLeftCorner<3, 3>().diagonal();
   out = robust_update<4>(z, h, r, true, std::isfinite(since_last_fix_s) && since_last_fix_s > 0.0 ? since_last_fix_s : 1.0);
+  if (out.accepted) {  // scalar form per axis: P+ = (1 - K) P-
+    double g = 0.0;
+    for (int i = 0; i < 3; ++i) g += (1.0 - p_(i, i) / prior_var(i)) / 3.0;
+    fix_gain_ = std::isfinite(g) ? std::clamp(g, 0.0, 1.0) : 0.0;
+  }
   if (out.reset) {
     // the filter diverged (persistent rejections): restart from the fix, keep the velocity
     const Eigen::Vector3d v = x_.segment<3>(3);

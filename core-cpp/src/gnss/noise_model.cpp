@@ -34,14 +34,15 @@ const CodeNoiseParams& CodeNoiseModel::params(Constellation sys, SignalBand band
   }
 }
 
-double cn0_elevation_variance(double a, double b, double cn0_dbhz, double el_rad) {
+double cn0_elevation_variance(double a, double b, double cn0_dbhz, double el_rad, double white_ratio) {
   const double s = std::max(std::sin(el_rad), 0.1);
-  return a / (s * s) + b * std::pow(10.0, -cn0_dbhz / 10.0);
+  return a / (s * s) + white_ratio * b * std::pow(10.0, -cn0_dbhz / 10.0);
 }
 
-double CodeNoiseModel::variance_m2(Constellation sys, double carrier_hz, double cn0_dbhz, double el_rad) const {
+double CodeNoiseModel::variance_m2(Constellation sys, double carrier_hz, double cn0_dbhz, double el_rad,
+                                   double white_ratio) const {
   const CodeNoiseParams& p = params(sys, signal_band(carrier_hz));
-  return cn0_elevation_variance(p.a_m2, p.b_m2hz, cn0_dbhz, el_rad);
+  return cn0_elevation_variance(p.a_m2, p.b_m2hz, cn0_dbhz, el_rad, white_ratio);
 }
 
 double CodeNoiseModel::zenith_variance_m2(Constellation sys, SignalBand band, double cn0_dbhz) const {
@@ -50,11 +51,11 @@ double CodeNoiseModel::zenith_variance_m2(Constellation sys, SignalBand band, do
 }
 
 double iono_free_variance_m2(const CodeNoiseModel& m, Constellation sys, double cn0_l1_dbhz, double cn0_l5_dbhz,
-                             double el_rad) {
+                             double el_rad, double white_ratio) {
   const CodeNoiseParams& p1 = m.params(sys, SignalBand::kL1);
   const CodeNoiseParams& p5 = m.params(sys, SignalBand::kL5);
-  return kIfAlpha * kIfAlpha * cn0_elevation_variance(p1.a_m2, p1.b_m2hz, cn0_l1_dbhz, el_rad) +
-         kIfBeta * kIfBeta * cn0_elevation_variance(p5.a_m2, p5.b_m2hz, cn0_l5_dbhz, el_rad);
+  return kIfAlpha * kIfAlpha * cn0_elevation_variance(p1.a_m2, p1.b_m2hz, cn0_l1_dbhz, el_rad, white_ratio) +
+         kIfBeta * kIfBeta * cn0_elevation_variance(p5.a_m2, p5.b_m2hz, cn0_l5_dbhz, el_rad, white_ratio);
 }
 
 }  // namespace pdnav::gnss

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace pdnav::gnss {
 
@@ -74,6 +75,11 @@ std::vector<double> CodeSmoother::smooth_epoch(const std::vector<SmoothingInput>
   return out;
 }
 
+double CodeSmoother::white_variance_ratio(const SatId& sat) const {
+  const auto it = sats_.find(sat);
+  return it == sats_.end() || it->second.epoch != epoch_ ? 1.0 : it->second.white_ratio;
+}
+
 double CodeSmoother::smooth(const SmoothingInput& in, std::string* reason) {
   if (!std::isfinite(in.pseudorange_m)) return in.pseudorange_m;
   Sat& s = sats_[in.sat];
@@ -84,10 +90,14 @@ double CodeSmoother::smooth(const SmoothingInput& in, std::string* reason) {
   else if (s.epoch == epoch_ - 1 && s.band != in.band && reason != nullptr)
     *reason = "smoothing: L1/L5 band switch (restarted)";
   double delta = std::nan("");
+  double propagation_ratio = 0.0;  // the propagation's variance over the code's white variance
   if (continuous && !carrier_broken_ && std::isfinite(in.adr_m) && std::isfinite(s.adr_m)) {
     delta = in.adr_m - s.adr_m - clock_jump_m_;
   } else if (continuous && std::isfinite(in.pr_rate_mps) && std::isfinite(s.pr_rate_mps)) {
     delta = 0.5 * (in.pr_rate_mps + s.pr_rate_mps) * dt_s_ - clock_jump_m_;
+    propagation_ratio = in.white_var_m2 > 0.0 && in.rate_var_m2ps2 >= 0.0
+                            ? in.rate_var_m2ps2 * dt_s_ * dt_s_ / in.white_var_m2
+                            : std::numeric_limits<double>::infinity();
   }
   const double predicted = s.pr_sm_m + delta;
   if (std::isfinite(delta) && std::fabs(in.pseudorange_m - predicted) > opt_.max_jump_m) {
@@ -97,8 +107,12 @@ double CodeSmoother::smooth(const SmoothingInput& in, std::string* reason) {
   if (std::isfinite(delta)) {
     s.n = std::min(s.n + 1.0, std::max(1.0, opt_.window_s / dt_s_));
     s.pr_sm_m = in.pseudorange_m / s.n + (s.n - 1.0) / s.n * predicted;
+    const double keep = (s.n - 1.0) / s.n;
+    if (std::isfinite(propagation_ratio))
+      s.white_ratio = std::min(1.0, keep * keep * (s.white_ratio + propagation_ratio) + 1.0 / (s.n * s.n));
   } else {
     s.n = 1.0;
+    s.white_ratio = 1.0;
     s.pr_sm_m = in.pseudorange_m;
   }
   s.adr_m = carrier_broken_ ? std::nan("") : in.adr_m;  // the carrier restarts at a clock break

@@ -25,6 +25,9 @@ namespace pdnav::gnss {
 struct GnssOptions {
   MeasurementOptions measurements;   // C/N0 >= 15 dB-Hz etc. (Walker 2019 Sec. 2.2)
   SmoothingOptions smoothing;        // Hatch carrier smoothing, 100 s (RTCA DO-229); window_s = 0 = raw code
+  /// Weight a smoothed code by what smoothing left of its white (C/N0) noise, the elevation
+  /// (multipath) term whole (RTCA DO-229 Appendix J's smoothed receiver noise vs multipath).
+  bool smoothed_code_white_noise = true;
   SppOptions spp;                    // WLS + ISB + FDE (Walker 2019 Eq. 1)
   TdcpOptions tdcp;                  // a = 10, b = 150^2 (Walker 2019 Sec. 2.4)
   KalmanOptions kalman;              // residual test 36 (Walker 2019 Sec. 2.5); dynamics (Groves 2013)

@@ -44,13 +44,14 @@ struct KalmanOptions {
   double drift_q_m2ps3 = 1e2;             // clock-drift random walk (TCXO under temperature change)
   double initial_velocity_var_m2ps2 = 400.0;  // (20 m/s)^2 before any velocity measurement
   // The SPP covariance treats each fix as independent; phone code errors are correlated over
-  // tens of seconds (multipath). Modelling the fix error as AR(1) with correlation rho per 1 s,
-  // treating it as white overstates the information by (1 + rho) / (1 - rho) (the effective
-  // sample size of a correlated series, von Storch & Zwiers 1999, Sec. 17.1.3). rho measured
-  // on the SPP errors against truth (docs/gnss.md "Code noise model"): 0.81 / 0.89 (north /
-  // east) on the moving GSDC car, 0.92-0.95 on the static Mountain View phone; rho = 0.85
-  // gives 12.3. Fixes dt apart get (1 + rho^dt) / (1 - rho^dt) (fix_variance_scale_for(dt)).
-  double fix_variance_scale = 12.3;
+  // tens of seconds (multipath). Fixes correlated by rho(k) at lag k carry the information of
+  // n / (1 + 2 sum rho(k)) independent ones (the effective sample size, von Storch & Zwiers 1999,
+  // Sec. 17.1.3). The SPP errors' autocorrelation has a long tail (rho(30 s) 0.2-0.5), so the
+  // sum is measured, not extrapolated from rho(1): over 30 s of lags, 35 / 30 (east / north) on
+  // the GSDC car (SP3 orbits), 40 / 27 on the static Mountain View phone (docs/gnss.md "Robust
+  // Kalman filter") -> 30, the scale of an average over all time: the AR(1) with rho = 29 / 31
+  // per second. The filter applies it over its own memory (fix_variance_scale_for(dt, gain)).
+  double fix_variance_scale = 30.0;
   double min_fix_variance_m2 = 1.0;       // floor of each axis of R (phone code errors are never < 1 m)
   double min_velocity_variance_m2ps2 = 0.01;  // floor of each axis of a velocity measurement
   // IGG-III (Yang et al. 2002): full weight up to k0, zero beyond k1, on the standardised
@@ -64,8 +65,11 @@ struct KalmanOptions {
   double max_rejected_span_s = 10.0;
 };
 
-/// R scale for SPP fixes dt_s apart (see KalmanOptions::fix_variance_scale); >= 1.
-double fix_variance_scale_for(const KalmanOptions& opt, double dt_s);
+/// R scale for SPP fixes dt_s apart (see KalmanOptions::fix_variance_scale); >= 1. A filter
+/// that gives each new fix the weight `gain` averages the fixes with weights gain (1 - gain)^j,
+/// exponential smoothing; for AR(1) errors the variance of that average is its white value times
+/// (1 + a) / (1 - a), a = rho^dt (1 - gain). gain 0 = an average over all time.
+double fix_variance_scale_for(const KalmanOptions& opt, double dt_s, double gain = 0.0);
 
 /// The IGG-III equivalent weight of a standardised residual t (Yang, Song & Xu 2002):
 /// 1 for |t| <= k0; k0/|t| * ((k1 - |t|)/(k1 - k0))^2 for k0 < |t| <= k1; 0 beyond k1.
@@ -143,6 +147,7 @@ class RobustKalman {
 
   KalmanOptions opt_;
   bool initialized_ = false;
+  double fix_gain_ = 0.0;  // the weight the last accepted fix got (mean over the position axes)
   int rejections_in_row_ = 0;
   double rejected_span_s_ = 0.0;
   Vector x_ = Vector::Zero();

@@ -40,7 +40,10 @@ struct CodeNoiseModel {
   /// QZSS uses GPS's, SBAS/IRNSS/unknown GPS L1's.
   const CodeNoiseParams& params(Constellation sys, SignalBand band) const;
   /// sigma^2 of one code measurement [m^2]; sin(el) is floored at 0.1.
-  double variance_m2(Constellation sys, double carrier_hz, double cn0_dbhz, double el_rad) const;
+  /// `white_ratio` scales the C/N0 (white, thermal) term only: what carrier smoothing leaves of
+  /// it (CodeSmoother::white_variance_ratio); the elevation term (multipath, slow) stays, as in
+  /// RTCA DO-229's split of the smoothed-code error into receiver noise and multipath.
+  double variance_m2(Constellation sys, double carrier_hz, double cn0_dbhz, double el_rad, double white_ratio = 1.0) const;
   /// Without the elevation term's mapping (el = 90 deg): the zenith variance.
   double zenith_variance_m2(Constellation sys, SignalBand band, double cn0_dbhz) const;
 };
@@ -49,9 +52,9 @@ struct CodeNoiseModel {
 /// independent noise on the two bands: alpha^2 v_L1 + beta^2 v_L5 (Misra & Enge 2011 Sec. 5.3.2),
 /// each band from its own (a, b) and C/N0 at the same elevation.
 double iono_free_variance_m2(const CodeNoiseModel& m, Constellation sys, double cn0_l1_dbhz, double cn0_l5_dbhz,
-                             double el_rad);
+                             double el_rad, double white_ratio = 1.0);
 
 /// The same model for one (a, b): a / max(sin el, 0.1)^2 + b 10^(-C/N0/10).
-double cn0_elevation_variance(double a, double b, double cn0_dbhz, double el_rad);
+double cn0_elevation_variance(double a, double b, double cn0_dbhz, double el_rad, double white_ratio = 1.0);
 
 }  // namespace pdnav::gnss

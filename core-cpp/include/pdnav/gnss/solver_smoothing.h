@@ -4,6 +4,7 @@
 // slipped. Code noise of a phone is white at the 1 s rate, so this cuts it by ~sqrt(window).
 #pragma once
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -48,6 +49,12 @@ struct SmoothingInput {
   /// The band of the code and carrier (FrequencyMode::kBest switches a satellite between L1
   /// and L5 when it gains or loses L5): a change restarts the satellite.
   SignalBand band = SignalBand::kL1;
+  /// The code's white (C/N0) noise variance (m^2) and the pseudorange rate's variance
+  /// ((m/s)^2): what an epoch propagated by Doppler adds to the smoothed code, relative to the
+  /// code's own noise (white_variance_ratio). NaN: not known (a Doppler epoch then does not
+  /// lower the ratio).
+  double white_var_m2 = std::numeric_limits<double>::quiet_NaN();
+  double rate_var_m2ps2 = std::numeric_limits<double>::quiet_NaN();
 };
 
 class CodeSmoother {
@@ -66,6 +73,13 @@ class CodeSmoother {
   /// median code-minus-propagation step is removed first. Returns one value per input;
   /// `reasons` (optional) gets one entry per input ("" when nothing to count).
   std::vector<double> smooth_epoch(const std::vector<SmoothingInput>& in, std::vector<std::string>* reasons = nullptr);
+  /// The share of a satellite's white (C/N0) code noise variance left in its smoothed code after
+  /// its last smooth(), the Hatch recursion's variance r_k = (1 - 1/n)^2 (r_k-1 + q) + 1/n^2:
+  /// 1 for raw code; with a carrier (q = 0) 1/n after n epochs and 1/(2N-1) once the window N
+  /// is full; an epoch propagated by Doppler adds q = rate variance dt^2 / white variance (the
+  /// mean of two rates: each rate enters two steps at half weight, so the propagation's random
+  /// walk grows by one rate variance per epoch). Satellite not smoothed at this epoch: 1.
+  double white_variance_ratio(const SatId& sat) const;
   /// The common step removed at the last smooth_epoch (m), 0 when none.
   double last_common_step_m() const { return common_step_m_; }
   void reset() { sats_.clear(); }
@@ -74,6 +88,7 @@ class CodeSmoother {
   struct Sat {
     double pr_sm_m = 0.0, adr_m = 0.0, pr_rate_mps = 0.0;
     double n = 0.0;
+    double white_ratio = 1.0;  // see white_variance_ratio
     std::int64_t epoch = -1;
     bool iono_free = false;
     SignalBand band = SignalBand::kL1;

@@ -65,6 +65,9 @@ struct SppObservation {
   bool iono_free = false;
   double var_scale = 1.0;           // multiplies the model variance
   double cn0_l5_dbhz = kNaN;        // the L5/E5a C/N0 of an iono_free code
+  /// The share of the white (C/N0) noise variance left after carrier smoothing
+  /// (CodeSmoother::white_variance_ratio); 1 = raw code.
+  double white_var_ratio = 1.0;
 };
 
 struct SppSolution {
