@@ -47,10 +47,10 @@ struct KalmanOptions {
   // tens of seconds (multipath). Fixes correlated by rho(k) at lag k carry the information of
   // n / (1 + 2 sum rho(k)) independent ones (the effective sample size, von Storch & Zwiers 1999,
   // Sec. 17.1.3). The SPP errors' autocorrelation has a long tail (rho(30 s) 0.2-0.5), so the
-  // sum is measured, not extrapolated from rho(1): over 30 s of lags, 35 / 30 (east / north) on
-  // the GSDC car (SP3 orbits), 40 / 27 on the static Mountain View phone (docs/gnss.md "Robust
-  // Kalman filter") -> 30, the scale of an average over all time: the AR(1) with rho = 29 / 31
-  // per second. The filter applies it over its own memory (fix_variance_scale_for(dt, gain)).
+  // sum is measured, not extrapolated from rho(1): over 30 s of lags, 41 / 28 (east / north) on
+  // the GSDC car (SP3 orbits), 40 / 29 on the static Mountain View phone (docs/gnss.md "Robust
+  // Kalman filter") -> 30 (the north value of both; east has the longer tail), the scale of an
+  // average over all time: the AR(1) with rho = 29 / 31 per second. The filter applies it over its own memory (fix_variance_scale_for(dt, gain)).
   double fix_variance_scale = 30.0;
   double min_fix_variance_m2 = 1.0;       // floor of each axis of R (phone code errors are never < 1 m)
   double min_velocity_variance_m2ps2 = 0.01;  // floor of each axis of a velocity measurement
