@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "pdnav/geo/frames.h"
+#include "pdnav/gnss/measurements.h"
 #include "pdnav/gnss/noise_model.h"
 #include "pdnav/gnss/solver_synthetic.h"
 #include "pdnav/gnss/spp.h"
@@ -38,6 +39,25 @@ TEST(NoiseModel, ParametersPerConstellationAndBand) {
             d.zenith_variance_m2(Constellation::kGps, SignalBand::kL1, 35.0));
   EXPECT_LT(d.zenith_variance_m2(Constellation::kGps, SignalBand::kL5, 35.0),
             d.zenith_variance_m2(Constellation::kGps, SignalBand::kL1, 35.0));
+}
+
+TEST(NoiseModel, TheWhiteTermIsTheShareTheSmoothingRatioScalesInEitherBandOrTheCombination) {
+  CodeNoiseModel m;
+  m.gps_l1 = {1.0, 10000.0};
+  m.gps_l5 = {2.0, 2000.0};
+  const double l1 = 1575.42e6;
+  // one band: b 10^(-C/N0/10), and the whole variance is a / sin^2 el + ratio x that
+  EXPECT_NEAR(code_white_variance_m2(m, Constellation::kGps, l1, false, 30.0, kNaN), 10.0, 1e-12);
+  EXPECT_NEAR(code_variance_m2(m, Constellation::kGps, l1, false, 30.0, kNaN, kPi / 6, 0.25), 4.0 + 2.5, 1e-12);
+  // the L1/L5 combination: alpha^2 and beta^2 of each band's own term
+  const double w_if = kIfAlpha * kIfAlpha * 10.0 + kIfBeta * kIfBeta * 2.0;
+  EXPECT_NEAR(code_white_variance_m2(m, Constellation::kGps, l1, true, 30.0, 30.0), w_if, 1e-9);
+  const double v_if = code_variance_m2(m, Constellation::kGps, l1, true, 30.0, 30.0, kPi / 2, 0.5);
+  EXPECT_NEAR(v_if, kIfAlpha * kIfAlpha * 1.0 + kIfBeta * kIfBeta * 2.0 + 0.5 * w_if, 1e-9);
+  EXPECT_NEAR(v_if, iono_free_variance_m2(m, Constellation::kGps, 30.0, 30.0, kPi / 2, 0.5), 1e-9);
+  // a combination without its L5 C/N0 is weighted as its L1 code
+  EXPECT_NEAR(code_variance_m2(m, Constellation::kGps, l1, true, 30.0, kNaN, kPi / 2), 11.0, 1e-12);
+  EXPECT_NEAR(code_white_variance_m2(m, Constellation::kGps, l1, true, 30.0, kNaN), 10.0, 1e-12);
 }
 
 struct Spread {

@@ -88,23 +88,16 @@ struct GnssEngine::Impl {
     return default_carrier_hz(m.sat.sys, ch);
   }
 
-  /// The white (C/N0) part of the code noise model's variance (the elevation term cancels).
+  /// The white (C/N0) part of the code noise model's variance.
   double white_code_variance_m2(const Measurement& m, const SatState& st) const {
-    const CodeNoiseModel& nm = opt.spp.code_noise;
-    if (m.iono_free && std::isfinite(m.cn0_l5_dbhz))
-      return iono_free_variance_m2(nm, m.sat.sys, m.cn0_dbhz, m.cn0_l5_dbhz, kPi / 2, 1.0) -
-             iono_free_variance_m2(nm, m.sat.sys, m.cn0_dbhz, m.cn0_l5_dbhz, kPi / 2, 0.0);
-    const double hz = carrier_hz(m, st);
-    return nm.variance_m2(m.sat.sys, hz, m.cn0_dbhz, kPi / 2, 1.0) - nm.variance_m2(m.sat.sys, hz, m.cn0_dbhz, kPi / 2, 0.0);
+    return code_white_variance_m2(opt.spp.code_noise, m.sat.sys, carrier_hz(m, st), m.iono_free, m.cn0_dbhz,
+                                  m.cn0_l5_dbhz);
   }
 
   /// The pseudorange rate's variance from its C/N0 (the Doppler velocity's model without a
   /// reported uncertainty, tdcp.h): RINEX carries no uncertainty, and a log and its RINEX must
   /// smooth alike.
-  double rate_variance_m2ps2(const Measurement& m) const {
-    const TdcpOptions& t = opt.tdcp;
-    return t.doppler_a_m2ps2 + t.doppler_b_m2ps2 * std::pow(10.0, -m.cn0_dbhz / 10.0);
-  }
+  double rate_variance_m2ps2(const Measurement& m) const { return doppler_cn0_variance_m2ps2(opt.tdcp, m.cn0_dbhz); }
 
   /// True when the receiver clock had a hardware discontinuity since the previous epoch.
   bool handle_clock_jump(const MeasurementEpoch& ep) {

@@ -34,9 +34,14 @@ const CodeNoiseParams& CodeNoiseModel::params(Constellation sys, SignalBand band
   }
 }
 
+namespace {
+double cn0_term(double b, double cn0_dbhz) { return b * std::pow(10.0, -cn0_dbhz / 10.0); }
+bool combined(bool iono_free, double cn0_l5_dbhz) { return iono_free && std::isfinite(cn0_l5_dbhz); }
+}  // namespace
+
 double cn0_elevation_variance(double a, double b, double cn0_dbhz, double el_rad, double white_ratio) {
   const double s = std::max(std::sin(el_rad), 0.1);
-  return a / (s * s) + white_ratio * b * std::pow(10.0, -cn0_dbhz / 10.0);
+  return a / (s * s) + white_ratio * cn0_term(b, cn0_dbhz);
 }
 
 double CodeNoiseModel::variance_m2(Constellation sys, double carrier_hz, double cn0_dbhz, double el_rad,
@@ -56,6 +61,20 @@ double iono_free_variance_m2(const CodeNoiseModel& m, Constellation sys, double 
   const CodeNoiseParams& p5 = m.params(sys, SignalBand::kL5);
   return kIfAlpha * kIfAlpha * cn0_elevation_variance(p1.a_m2, p1.b_m2hz, cn0_l1_dbhz, el_rad, white_ratio) +
          kIfBeta * kIfBeta * cn0_elevation_variance(p5.a_m2, p5.b_m2hz, cn0_l5_dbhz, el_rad, white_ratio);
+}
+
+double code_variance_m2(const CodeNoiseModel& m, Constellation sys, double carrier_hz, bool iono_free,
+                        double cn0_dbhz, double cn0_l5_dbhz, double el_rad, double white_ratio) {
+  return combined(iono_free, cn0_l5_dbhz) ? iono_free_variance_m2(m, sys, cn0_dbhz, cn0_l5_dbhz, el_rad, white_ratio)
+                                          : m.variance_m2(sys, carrier_hz, cn0_dbhz, el_rad, white_ratio);
+}
+
+double code_white_variance_m2(const CodeNoiseModel& m, Constellation sys, double carrier_hz, bool iono_free,
+                              double cn0_dbhz, double cn0_l5_dbhz) {
+  if (combined(iono_free, cn0_l5_dbhz))
+    return kIfAlpha * kIfAlpha * cn0_term(m.params(sys, SignalBand::kL1).b_m2hz, cn0_dbhz) +
+           kIfBeta * kIfBeta * cn0_term(m.params(sys, SignalBand::kL5).b_m2hz, cn0_l5_dbhz);
+  return cn0_term(m.params(sys, signal_band(carrier_hz)).b_m2hz, cn0_dbhz);
 }
 
 }  // namespace pdnav::gnss

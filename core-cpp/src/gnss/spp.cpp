@@ -115,11 +115,8 @@ Row model_row(const SppObservation& o, const Eigen::VectorXd& x, const Layout& l
   }
   const double sat_clock_m = kSpeedOfLight_mps * (o.state.clock_bias_s - (o.iono_free ? 0.0 : signal_group_delay_s(o)));
   r.residual_m = o.pseudorange_m - (range + clock - sat_clock_m + atmo_m);
-  r.var_m2 = o.var_scale * (o.iono_free && std::isfinite(o.cn0_l5_dbhz)
-                                ? iono_free_variance_m2(opt.code_noise, o.sat.sys, o.cn0_dbhz, o.cn0_l5_dbhz, r.el_rad,
-                                                        o.white_var_ratio)
-                                : opt.code_noise.variance_m2(o.sat.sys, o.carrier_hz, o.cn0_dbhz, r.el_rad,
-                                                             o.white_var_ratio));
+  r.var_m2 = o.var_scale * code_variance_m2(opt.code_noise, o.sat.sys, o.carrier_hz, o.iono_free, o.cn0_dbhz,
+                                            o.cn0_l5_dbhz, r.el_rad, o.white_var_ratio);
   return r;
 }
 

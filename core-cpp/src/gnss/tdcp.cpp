@@ -164,13 +164,17 @@ DisplacementSolution solve_doppler(const std::vector<CarrierObservation>& epoch,
     r.los = (s - rx).normalized();
     const Eigen::Vector3d sat_vel = rotate_for_travel_time(o.state.vel_mps, (s - rx).norm() / kSpeedOfLight_mps);
     r.y = o.pr_rate_mps - sat_vel.dot(r.los) + kSpeedOfLight_mps * o.state.clock_drift_sps;
-    const double cn0_var = snr_variance(opt.doppler_a_m2ps2, opt.doppler_b_m2ps2, o.cn0_dbhz);
+    const double cn0_var = doppler_cn0_variance_m2ps2(opt, o.cn0_dbhz);
     r.var = std::isfinite(o.pr_rate_sigma_mps) && o.pr_rate_sigma_mps > 0.0
                 ? std::max(o.pr_rate_sigma_mps * o.pr_rate_sigma_mps, opt.doppler_a_m2ps2) : cn0_var;
     rows.push_back(r);
   }
   const WlsOut w = robust_wls(rows, opt, ex, "doppler: FDE residual test");
   return finish(w, "doppler", dt_s, dt_s, ex);
+}
+
+double doppler_cn0_variance_m2ps2(const TdcpOptions& opt, double cn0_dbhz) {
+  return snr_variance(opt.doppler_a_m2ps2, opt.doppler_b_m2ps2, cn0_dbhz);
 }
 
 bool same_signal(const CarrierObservation& a, const CarrierObservation& b) {

@@ -50,7 +50,8 @@ struct KalmanOptions {
   // sum is measured, not extrapolated from rho(1): over 30 s of lags, 41 / 28 (east / north) on
   // the GSDC car (SP3 orbits), 40 / 29 on the static Mountain View phone (docs/gnss.md "Robust
   // Kalman filter") -> 30 (the north value of both; east has the longer tail), the scale of an
-  // average over all time: the AR(1) with rho = 29 / 31 per second. The filter applies it over its own memory (fix_variance_scale_for(dt, gain)).
+  // average over all time: the AR(1) with rho = 29 / 31 per second. The filter applies it over
+  // its own memory (fix_variance_scale_for(dt, gain)).
   double fix_variance_scale = 30.0;
   double min_fix_variance_m2 = 1.0;       // floor of each axis of R (phone code errors are never < 1 m)
   double min_velocity_variance_m2ps2 = 0.01;  // floor of each axis of a velocity measurement

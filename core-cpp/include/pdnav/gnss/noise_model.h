@@ -57,4 +57,13 @@ double iono_free_variance_m2(const CodeNoiseModel& m, Constellation sys, double 
 /// The same model for one (a, b): a / max(sin el, 0.1)^2 + b 10^(-C/N0/10).
 double cn0_elevation_variance(double a, double b, double cn0_dbhz, double el_rad, double white_ratio = 1.0);
 
+/// One code's variance, the one dispatch the SPP and the smoother share: the ionosphere-free
+/// model when the code is an L1/L5 combination with its L5 C/N0 known, else its carrier's band.
+double code_variance_m2(const CodeNoiseModel& m, Constellation sys, double carrier_hz, bool iono_free,
+                        double cn0_dbhz, double cn0_l5_dbhz, double el_rad, double white_ratio = 1.0);
+/// The white (C/N0) term of that variance alone, b 10^(-C/N0/10) (per band for the combination):
+/// the share carrier smoothing averages (CodeSmoother::white_variance_ratio).
+double code_white_variance_m2(const CodeNoiseModel& m, Constellation sys, double carrier_hz, bool iono_free,
+                              double cn0_dbhz, double cn0_l5_dbhz);
+
 }  // namespace pdnav::gnss

@@ -47,6 +47,11 @@ struct CarrierObservation {
 /// same tracking code when both known); TDCP across a signal change is meaningless.
 bool same_signal(const CarrierObservation& a, const CarrierObservation& b);
 
+/// The Doppler (pseudorange rate) variance from C/N0 alone, doppler_a + doppler_b 10^(-C/N0/10)
+/// [(m/s)^2]: the Doppler velocity's weight without a reported uncertainty, and the code
+/// smoother's propagation noise.
+double doppler_cn0_variance_m2ps2(const TdcpOptions& opt, double cn0_dbhz);
+
 struct DisplacementSolution {
   bool ok = false;
   std::string reason;
