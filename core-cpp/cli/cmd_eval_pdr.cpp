@@ -40,6 +40,7 @@
 #include "pdnav/geo/frames.h"
 #include "pdnav/geo/wmm.h"
 #include "pdnav/io/log_reader.h"
+#include "pdnav/io/log_writer.h"
 #include "pdnav/io/sample_source.h"
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/phonesim/handling.h"
@@ -74,6 +75,7 @@ struct EvalPdrArgs {
   double segment_min_m = 0.0;   // 0: a segment per Truth line (surveyed waypoints)
   double align_start_s = 0.0;   // 0: no alignment (absolute tracks)
   std::string json_out;         // one JSON object per walk, one per line
+  std::string write_logs_dir;   // each walk as evaluated (pitched, waved, sensor set) as a session log
   std::string reference = "auto";  // truth | fixes | auto (Truth lines when a log has 2+, else its fixes)
   double fix_max_accuracy_m = 10.0;  // --reference fixes: fixes stating a worse 68 % accuracy are not scored
 };
@@ -499,6 +501,13 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   TimeNs walk_start_ns = std::numeric_limits<TimeNs>::min();
   if (a.pitch_deg != 0.0) samples = with_pitch(samples, a.pitch_deg, path);
   if (a.wave_s > 0.0) samples = with_waving(samples, a, path, &walk_start_ns);
+  if (!a.write_logs_dir.empty()) {  // what is scored below, replayable with `pdnav replay`
+    const std::string base = path.substr(path.find_last_of('/') + 1);
+    io::LogWriter w(a.write_logs_dir + "/" + base);
+    for (const Sample& s : samples)
+      if (sensor_set_keeps(a.sensors, s)) w.write(s);
+    w.close();
+  }
   Runner run(a);
   NaivePdr naive;
   geo::LocalFrame frame;
@@ -838,6 +847,10 @@ void register_eval_pdr(CLI::App& app) {
                  "every walk with the phone pitched this much further (deg, top edge up) about the walk's "
                  "horizontal lateral axis: the same walk, the phone held at another pitch")
       ->check(CLI::Range(-80.0, 80.0));
+  c->add_option("--write-logs", a->write_logs_dir,
+                 "write each walk as evaluated (pitched, waved, sensor set kept) as a session log in this "
+                 "existing folder, under its own file name, to replay or plot")
+      ->check(CLI::ExistingDirectory);
   c->add_flag("--quiet", a->quiet, "one line per walk");
   c->add_option("--sensors", a->sensors, "sensor set kept from each log: all | accel | imu | rv | uncal | game")
       ->capture_default_str();

@@ -84,6 +84,15 @@ add_test(NAME pdr_cli_eval_pdr_pitch
                  "${_pdr_ilc_out}/site1_F4_5ddb656fc5b77e0006b1792e.log")
 set_tests_properties(pdr_cli_eval_pdr_pitch PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_ilc
                      PASS_REGULAR_EXPRESSION "walks 3 \\(failed 0\\).*median_mean_error_m: [0-5]\\.[0-9]+ median_length_ratio: [01]\\.[0-9]+\n")
+# eval-pdr --write-logs: each walk as scored (pitched, waved) is written as a session log that
+# replays to the same figures (a field tester can replay, inspect and plot what was scored): the
+# per-walk line of the transformed walk and of its written log must agree.
+add_test(NAME pdr_cli_eval_pdr_write_logs
+         COMMAND sh -c "d=\"$2\"; rm -rf \"$d\"; mkdir -p \"$d\" || exit 1; a=$(\"$0\" eval-pdr --quiet --pitch 65 --wave 10 --write-logs \"$d\" \"$1\" 2>/dev/null | grep '^site') || exit 1; b=$(\"$0\" eval-pdr --quiet \"$d/$(basename \"$1\")\" 2>/dev/null | grep '^site') || exit 1; echo \"scored:  $a\"; echo \"written: $b\"; [ -n \"$a\" ] && [ \"$(echo \"$a\" | sed 's/| naive.*//')\" = \"$(echo \"$b\" | sed 's/| naive.*//')\" ] && echo same"
+                 $<TARGET_FILE:pdnav> "${_pdr_ilc_out}/site2_F3_5dd38fff44333f00067aa387.log"
+                 "${PROJECT_BINARY_DIR}/test-scratch/pdr-written-logs")
+set_tests_properties(pdr_cli_eval_pdr_write_logs PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_ilc
+                     PASS_REGULAR_EXPRESSION "\nsame")
 # Issue 27: two TYREX motion-capture recordings converted by tools/tyrex2log (steps counted from
 # the capture: the slow texting walk ~1.15 Hz, the run 2.72 Hz, matching the phone's own
 # accelerometer spectrum; the count within 10 % of the two independent counts it prints, the
