@@ -3,7 +3,9 @@
 // constellation, exclusions by reason), error statistics against a static truth.
 // The last line is always
 //   spp_p50_h_m: A spp_p95_h_m: B kf_rms_h_m: C tdcp_rms_cm: D
-// (nan where there is no truth or no data; D = worst axis RMS of the 1 s TDCP displacement).
+// (nan where there is no truth or no data; D = worst axis RMS of the 1 s TDCP displacement's
+// error: the displacement itself against a static --truth, the displacement less the truth
+// track's own over the same second with --truth-csv).
 #include <cmath>
 #include <cstdio>
 #include <algorithm>
@@ -367,9 +369,11 @@ void run_gnss(const GnssArgs& a) {
   if (!a.residuals_out.empty()) write_residuals(a.residuals_out, sols, a, *store, options.spp);
   const gnss::StaticAccuracy acc = gnss::evaluate_static(sols, truth);
   if (have_truth) print_accuracy(acc);
+  double tdcp_rms_m = have_truth ? acc.tdcp_rms_max_axis_m() : kNaN;  // static: the displacement is its error
   if (!a.truth_csv.empty()) {
     const gnss::TruthTrack track = gnss::read_truth_csv_file(a.truth_csv);
     const gnss::TrackAccuracy t = gnss::evaluate_track(sols, track);
+    tdcp_rms_m = t.tdcp_err_rms_max_axis_m();
     std::printf("truth track %s: %zu points, %lld rows skipped\n", a.truth_csv.c_str(), track.points.size(),
                 static_cast<long long>(track.skipped_rows));
     std::printf("%-6s %8s %8s %8s %8s %8s %8s\n", "track", "p50_h_m", "p95_h_m", "rms_h_m", "score_m", "avail", "cov68");
@@ -379,11 +383,16 @@ void run_gnss(const GnssArgs& a) {
     std::printf("track_spp_score_m: %.2f track_spp_avail: %.3f track_kf_score_m: %.2f track_kf_avail: %.3f "
                 "track_kf_cov68: %.3f\n", t.spp.score_m, t.spp.availability, t.kf.score_m, t.kf.availability,
                 t.kf.coverage68);
+    const auto cm = [](const Eigen::Vector3d& v) { return Eigen::Vector3d(100.0 * v); };
+    const Eigen::Vector3d te = cm(t.tdcp_err_rms_enu_m), de = cm(t.doppler_err_rms_enu_m);
+    std::printf("1 s displacement vs the truth's: TDCP rms e/n/u %.1f / %.1f / %.1f cm (%d epochs), "
+                "Doppler %.1f / %.1f / %.1f cm (%d epochs)\n",
+                te.x(), te.y(), te.z(), t.tdcp_epochs, de.x(), de.y(), de.z(), t.doppler_epochs);
   }
   const double nan = kNaN;
   std::printf("spp_p50_h_m: %.2f spp_p95_h_m: %.2f kf_rms_h_m: %.2f tdcp_rms_cm: %.2f kf_cov68: %.3f\n",
               have_truth ? acc.spp_p50_h_m : nan, have_truth ? acc.spp_p95_h_m : nan,
-              have_truth ? acc.kf_rms_h_m : nan, acc.tdcp_rms_max_axis_m() * 100.0,
+              have_truth ? acc.kf_rms_h_m : nan, tdcp_rms_m * 100.0,
               have_truth ? acc.kf_coverage68 : nan);
 }
 

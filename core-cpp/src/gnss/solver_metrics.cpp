@@ -176,12 +176,19 @@ bool truth_at(const TruthTrack& t, std::int64_t gps_ns, geo::Geodetic& out, doub
 
 TrackAccuracy evaluate_track(const std::vector<EpochSolution>& sols, const TruthTrack& truth) {
   std::vector<double> spp_h, kf_h;
+  std::vector<Eigen::Vector3d> tdcp_err, dopp_err;
   int epochs = 0, inside = 0;
   for (const EpochSolution& s : sols) {
     geo::Geodetic g;
     if (!truth_at(truth, s.gps_ns, g)) continue;
     ++epochs;
     const geo::LocalFrame frame(g);
+    geo::Geodetic before;
+    if (!s.disp_source.empty() && std::fabs(s.disp_dt_s - 1.0) <= 0.1 &&
+        truth_at(truth, s.gps_ns - std::llround(s.disp_dt_s * 1e9), before)) {
+      const Eigen::Vector3d truth_disp = -frame.to_enu(before).p_m;  // from the earlier truth to this one
+      (s.disp_source == "tdcp" ? tdcp_err : dopp_err).push_back(s.tdcp_disp_m - truth_disp);
+    }
     if (s.spp_ok) {
       const geo::Enu e = frame.to_enu(s.spp);
       spp_h.push_back(std::hypot(e.e_m(), e.n_m()));
@@ -205,6 +212,10 @@ TrackAccuracy evaluate_track(const std::vector<EpochSolution>& sols, const Truth
   fill(a.spp, spp_h);
   fill(a.kf, kf_h);
   a.kf.coverage68 = kf_h.empty() ? kNaN : static_cast<double>(inside) / static_cast<double>(kf_h.size());
+  a.tdcp_epochs = static_cast<int>(tdcp_err.size());
+  a.doppler_epochs = static_cast<int>(dopp_err.size());
+  a.tdcp_err_rms_enu_m = rms_axes(tdcp_err);
+  a.doppler_err_rms_enu_m = rms_axes(dopp_err);
   return a;
 }
 

@@ -69,6 +69,13 @@ struct TrackStats {
 
 struct TrackAccuracy {
   TrackStats spp, kf;
+  /// The 1 s displacement (TDCP, and the Doppler fallback) against the truth track's own
+  /// displacement over the same interval: per-axis RMS of the error (ENU at the epoch's truth),
+  /// over the epochs whose interval is 1 s +- 0.1 s and whose two ends the truth covers.
+  int tdcp_epochs = 0, doppler_epochs = 0;
+  Eigen::Vector3d tdcp_err_rms_enu_m = Eigen::Vector3d::Constant(kNaN);
+  Eigen::Vector3d doppler_err_rms_enu_m = Eigen::Vector3d::Constant(kNaN);
+  double tdcp_err_rms_max_axis_m() const { return tdcp_err_rms_enu_m.allFinite() ? tdcp_err_rms_enu_m.maxCoeff() : kNaN; }
 };
 
 TrackAccuracy evaluate_track(const std::vector<EpochSolution>& sols, const TruthTrack& truth);
