@@ -46,6 +46,7 @@ struct GnssArgs {
   bool strip_adr = false;
   double smoothing_window_s = gnss::SmoothingOptions{}.window_s;
   bool smoothed_white_noise = gnss::GnssOptions{}.smoothed_code_white_noise;
+  double fix_bias_sigma_h_m = gnss::GnssOptions{}.fix_bias_sigma_h_m;
   std::uint64_t seed = 1;
   int keep_every = 1;  // robustness check: keep every N-th epoch (duty cycling)
   bool clock_steps = false;  // robustness check: a 1 ms code-only clock step every epoch
@@ -331,6 +332,7 @@ void run_gnss(const GnssArgs& a) {
   gnss::GnssOptions options;
   options.smoothing.window_s = a.smoothing_window_s;
   options.smoothed_code_white_noise = a.smoothed_white_noise;
+  options.fix_bias_sigma_h_m = a.fix_bias_sigma_h_m;
   options.smoothing.iono_window_s = a.iono_window_s;
   options.measurements.dual_min_sats = a.dual_min_sats;
   options.measurements.dual_min_fraction = a.dual_min_fraction;
@@ -420,6 +422,11 @@ void register_gnss(CLI::App& app) {
   cmd->add_flag("--strip-adr", args->strip_adr, "drop carrier phase (tests the Doppler fallback)");
   cmd->add_option("--smoothing-window", args->smoothing_window_s,
                   "carrier smoothing window of the code, s (RTCA DO-229: 100; 0 = raw code)")->check(CLI::Range(0.0, 3600.0));
+  cmd->add_option("--fix-bias-sigma", args->fix_bias_sigma_h_m,
+                  "the fixes' common bias per horizontal axis, m, added to the KF's reported covariance "
+                  "(a consider variance: the estimate is unchanged; 0 = off)")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
   cmd->add_option("--smoothed-white-noise", args->smoothed_white_noise,
                   "weight a smoothed code by what smoothing left of its C/N0 noise (true, default) or as raw code (false)");
   cmd->add_option("--kf-displacement-q", args->kf_displacement_q_m2,

@@ -99,6 +99,17 @@ struct GnssEngine::Impl {
   /// smooth alike.
   double rate_variance_m2ps2(const Measurement& m) const { return doppler_cn0_variance_m2ps2(opt.tdcp, m.cn0_dbhz); }
 
+  /// The KF's position covariance (ENU) as reported: with the fixes' common bias, a consider
+  /// variance on each horizontal axis (GnssOptions::fix_bias_sigma_h_m; the estimate is the KF's).
+  Eigen::Matrix3d reported_cov_enu() const {
+    Eigen::Matrix3d c = kf.position_cov_enu();
+    if (opt.fix_bias_sigma_h_m > 0.0) {
+      c(0, 0) += opt.fix_bias_sigma_h_m * opt.fix_bias_sigma_h_m;
+      c(1, 1) += opt.fix_bias_sigma_h_m * opt.fix_bias_sigma_h_m;
+    }
+    return c;
+  }
+
   /// True when the receiver clock had a hardware discontinuity since the previous epoch.
   bool handle_clock_jump(const MeasurementEpoch& ep) {
     const bool jump =
@@ -327,7 +338,7 @@ struct GnssEngine::Impl {
     sol.kf_ok = true;
     sol.kf = kf.position();
     sol.clock_m = kf.clock_m();
-    sol.kf_cov_enu = kf.position_cov_enu();
+    sol.kf_cov_enu = reported_cov_enu();
     sol.kf_vel_enu_mps = geo::ecef_to_enu_rotation(geo::to_geodetic(kf.position())) * kf.velocity_ecef_mps();
     last_pos = kf.position();
     if (!have_frame) { frame = geo::LocalFrame(geo::to_geodetic(last_pos)); have_frame = true; }
@@ -413,7 +424,7 @@ Estimate GnssEngine::estimate() const {
   }
   e.position = geo::to_geodetic(m.kf.position());
   e.en_m = m.frame.to_enu(m.kf.position()).p_m.head<2>();
-  const Eigen::Matrix3d cov = m.kf.position_cov_enu();
+  const Eigen::Matrix3d cov = m.reported_cov_enu();
   e.cov_en_m2 = cov.topLeftCorner<2, 2>();
   e.vertical_sigma_m = std::sqrt(std::max(cov(2, 2), 0.0));
   if (m.epochs_since_update >= m.opt.lost_after_epochs) {
