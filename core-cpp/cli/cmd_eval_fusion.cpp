@@ -328,7 +328,10 @@ int run_eval_fusion(const EvalFusionArgs& a) {
                 w, static_cast<unsigned long long>(ws), r.length_m, r.outage_s, r.stats.mean_sats_tracked, f3(r.outage_ratio).c_str(),
                 f3(r.out_scored > 0 ? static_cast<double>(r.out_covered_68) / r.out_scored : kNaNd).c_str(),
                 f3(r.max_jump_sigma).c_str(), f1(r.reacquire_s).c_str(), r.reacquire_censored ? " (never, censored)" : "", f1(r.gnss_back_s).c_str(),
-                f3(r.open_sky_ratio).c_str(), f1(100 * r.cal_dr.first).c_str(), f1(r.cal_dr.second).c_str(),
+                std::isfinite(r.open_sky_ratio) ? f3(r.open_sky_ratio).c_str()
+                                                : "- (no open-sky epoch after the first 60 s, outside the outage, "
+                                                  "its 30 s after and degraded spans: not in the median)",
+                f1(100 * r.cal_dr.first).c_str(), f1(r.cal_dr.second).c_str(),
                 f1(100 * r.cal_fused.first).c_str(), f1(r.cal_fused.second).c_str(), r.stats.walker_stride_scale,
                 r.stats.heading_bias_at_outage_deg, static_cast<long long>(r.route_scale_used),
                 static_cast<long long>(r.route_scale_rejected));
