@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <iomanip>
@@ -502,7 +503,8 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   if (a.pitch_deg != 0.0) samples = with_pitch(samples, a.pitch_deg, path);
   if (a.wave_s > 0.0) samples = with_waving(samples, a, path, &walk_start_ns);
   if (!a.write_logs_dir.empty()) {  // what is scored below, replayable with `pdnav replay`
-    const std::string base = path.substr(path.find_last_of('/') + 1);
+    std::string base = std::filesystem::path(path).filename().string();  // a file, a folder or a zip
+    if (base.size() < 4 || base.compare(base.size() - 4, 4, ".log") != 0) base += ".log";
     io::LogWriter w(a.write_logs_dir + "/" + base);
     for (const Sample& s : samples)
       if (sensor_set_keeps(a.sensors, s)) w.write(s);
@@ -849,7 +851,8 @@ void register_eval_pdr(CLI::App& app) {
       ->check(CLI::Range(-80.0, 80.0));
   c->add_option("--write-logs", a->write_logs_dir,
                  "write each walk as evaluated (pitched, waved, sensor set kept) as a session log in this "
-                 "existing folder, under its own file name, to replay or plot")
+                 "existing folder, under its input's file name (+ .log), to replay or plot; with --reference fixes "
+                 "the scored fixes are written as its Truth rows")
       ->check(CLI::ExistingDirectory);
   c->add_flag("--quiet", a->quiet, "one line per walk");
   c->add_option("--sensors", a->sensors, "sensor set kept from each log: all | accel | imu | rv | uncal | game")
