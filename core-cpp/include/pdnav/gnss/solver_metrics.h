@@ -15,6 +15,9 @@
 
 namespace pdnav::gnss {
 
+/// The worst axis of a per-axis RMS, NaN when any axis has none.
+inline double worst_axis_m(const Eigen::Vector3d& rms_m) { return rms_m.allFinite() ? rms_m.maxCoeff() : kNaN; }
+
 struct StaticAccuracy {
   int spp_epochs = 0, kf_epochs = 0, tdcp_epochs = 0, doppler_epochs = 0;
   double spp_p50_h_m = kNaN, spp_p95_h_m = kNaN, spp_rms_h_m = kNaN, spp_rms_v_m = kNaN;
@@ -24,7 +27,7 @@ struct StaticAccuracy {
   double kf_coverage68 = kNaN;
   Eigen::Vector3d tdcp_rms_enu_m = Eigen::Vector3d::Constant(kNaN);     // per axis, TDCP epochs
   Eigen::Vector3d doppler_rms_enu_m = Eigen::Vector3d::Constant(kNaN);  // per axis, Doppler fallback epochs
-  double tdcp_rms_max_axis_m() const { return tdcp_rms_enu_m.allFinite() ? tdcp_rms_enu_m.maxCoeff() : kNaN; }
+  double tdcp_rms_max_axis_m() const { return worst_axis_m(tdcp_rms_enu_m); }
 };
 
 /// Percentile (0..100) by linear interpolation between order statistics; NaN when empty.
@@ -75,7 +78,7 @@ struct TrackAccuracy {
   int tdcp_epochs = 0, doppler_epochs = 0;
   Eigen::Vector3d tdcp_err_rms_enu_m = Eigen::Vector3d::Constant(kNaN);
   Eigen::Vector3d doppler_err_rms_enu_m = Eigen::Vector3d::Constant(kNaN);
-  double tdcp_err_rms_max_axis_m() const { return tdcp_err_rms_enu_m.allFinite() ? tdcp_err_rms_enu_m.maxCoeff() : kNaN; }
+  double tdcp_err_rms_max_axis_m() const { return worst_axis_m(tdcp_err_rms_enu_m); }
 };
 
 TrackAccuracy evaluate_track(const std::vector<EpochSolution>& sols, const TruthTrack& truth);
