@@ -8,13 +8,15 @@
 // capture, tools/tyrex2log) use --segment-min-m (a segment ends once the truth has moved that
 // far along its path) and --align-start-s (the track rotated about the start to fit the truth
 // over the first seconds: relative heading, the RMS % of distance). --sensors keeps
-// one sensor set of the log (accel, imu, rv, uncal, game, all); --json writes one object per
+// one sensor set of the log (accel, imu, rv, uncal, game, all); --rate, --pitch and --wave
+// replay the walk as another phone, grip or start would give it; --json writes one object per
 // walk (Meta Carry/Gait/Disturbance/TruthSteps included) for tools/eval-pdr-all.
 // Last line: `median_mean_error_m: X median_length_ratio: Y`.
 //   --via navigator (default): fusion::Navigator in dead-reckoning mode, exactly what
 //                              `pdnav replay --engine dr` runs;
 //   --via pdr: pdr::Pdr integrated step by step, with --length/--k to compare length models.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -72,6 +74,7 @@ struct EvalPdrArgs {
   std::uint64_t wave_seed = 1;
   double wave_amplitude = 1.0;
   double pitch_deg = 0.0;     // every walk with the phone pitched this much further (0 = as recorded)
+  double rate_hz = 0.0;       // motion sensors block-averaged to at most this rate (0 = as recorded)
   std::string sensors = "all";  // sensor set kept from each log (sensor_set_keeps)
   double segment_min_m = 0.0;   // 0: a segment per Truth line (surveyed waypoints)
   double align_start_s = 0.0;   // 0: no alignment (absolute tracks)
@@ -396,6 +399,81 @@ std::vector<Sample> with_pitch(const std::vector<Sample>& in, double pitch_deg, 
   return out;
 }
 
+/// The walk as a phone sampling its motion sensors at no more than --rate Hz would have
+/// recorded it: each accelerometer, gyroscope and magnetometer stream (and their uncalibrated
+/// twins) averaged over consecutive blocks of 1 / rate s, each block stamped with its last
+/// sample's time (an output data rate with its anti-alias averaging, what a sensor hub
+/// delivers at a lower rate); the rotation vectors and orientation angles keep the last sample
+/// of each block; every other line as recorded. A stream already at or below the rate is kept.
+std::vector<Sample> with_rate(const std::vector<Sample>& in, double rate_hz) {
+  const TimeNs block_ns = static_cast<TimeNs>(std::llround(1e9 / rate_hz));
+  struct Block {
+    bool open = false;
+    TimeNs start_ns = 0;
+    int n = 0;
+    Sample last;
+    Eigen::Vector3d sum_a = Eigen::Vector3d::Zero(), sum_b = Eigen::Vector3d::Zero();
+  };
+  std::array<Block, std::variant_size_v<Sample>> blocks;
+  std::vector<Sample> out;
+  out.reserve(in.size());
+  const auto vectors = [](const Sample& s, Eigen::Vector3d* a, Eigen::Vector3d* b) -> bool {
+    return std::visit(
+        [&](const auto& x) -> bool {
+          using T = std::decay_t<decltype(x)>;
+          if constexpr (std::is_same_v<T, AccelSample>) return *a = x.acc_mps2, *b = Eigen::Vector3d::Zero(), true;
+          else if constexpr (std::is_same_v<T, GyroSample>) return *a = x.rate_radps, *b = Eigen::Vector3d::Zero(), true;
+          else if constexpr (std::is_same_v<T, MagSample>) return *a = x.field_ut, *b = Eigen::Vector3d::Zero(), true;
+          else if constexpr (std::is_same_v<T, UncalAccelSample>) return *a = x.acc_mps2, *b = x.bias_mps2, true;
+          else if constexpr (std::is_same_v<T, UncalGyroSample>) return *a = x.rate_radps, *b = x.drift_radps, true;
+          else if constexpr (std::is_same_v<T, UncalMagSample>) return *a = x.field_ut, *b = x.bias_ut, true;
+          else return false;
+        },
+        s);
+  };
+  const auto flush = [&](Block& b) {
+    if (!b.open) return;
+    Sample s = b.last;
+    const Eigen::Vector3d ma = b.sum_a / b.n, mb = b.sum_b / b.n;
+    std::visit(
+        [&](auto& x) {
+          using T = std::decay_t<decltype(x)>;
+          if constexpr (std::is_same_v<T, AccelSample>) x.acc_mps2 = ma;
+          else if constexpr (std::is_same_v<T, GyroSample>) x.rate_radps = ma;
+          else if constexpr (std::is_same_v<T, MagSample>) x.field_ut = ma;
+          else if constexpr (std::is_same_v<T, UncalAccelSample>) x.acc_mps2 = ma, x.bias_mps2 = mb;
+          else if constexpr (std::is_same_v<T, UncalGyroSample>) x.rate_radps = ma, x.drift_radps = mb;
+          else if constexpr (std::is_same_v<T, UncalMagSample>) x.field_ut = ma, x.bias_ut = mb;
+        },
+        s);
+    out.push_back(std::move(s));
+    b = Block{};
+  };
+  for (const Sample& s : in) {
+    Eigen::Vector3d va, vb;
+    const bool vec = vectors(s, &va, &vb);
+    const bool decimated = std::holds_alternative<RotationVectorSample>(s) || std::holds_alternative<GameRotationVectorSample>(s) ||
+                           std::holds_alternative<OrientationSample>(s);
+    if (!vec && !decimated) {
+      out.push_back(s);
+      continue;
+    }
+    Block& b = blocks[s.index()];
+    const TimeNs t = sample_time_ns(s);
+    if (b.open && (t - b.start_ns >= block_ns || t < b.start_ns)) flush(b);
+    if (!b.open) b.open = true, b.start_ns = t;
+    if (vec && va.allFinite() && vb.allFinite()) {
+      b.sum_a += va, b.sum_b += vb, ++b.n, b.last = s;
+    } else if (!vec) {
+      b.n = 1, b.last = s;
+    }
+    if (b.n == 0) b = Block{};  // a non-finite reading alone: dropped (the block restarts)
+  }
+  for (Block& b : blocks) flush(b);
+  std::stable_sort(out.begin(), out.end(), [](const Sample& x, const Sample& y) { return sample_time_ns(x) < sample_time_ns(y); });
+  return out;
+}
+
 /// The walk as if the walker had first waved the phone for --wave seconds standing at the first
 /// waypoint (the "as recorded" sessions, which start with calibration waving): the first
 /// Truth line moves to the start of the waving, the synthesised samples (phonesim/handling.h)
@@ -500,6 +578,7 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
     }
   }
   TimeNs walk_start_ns = std::numeric_limits<TimeNs>::min();
+  if (a.rate_hz > 0.0) samples = with_rate(samples, a.rate_hz);
   if (a.pitch_deg != 0.0) samples = with_pitch(samples, a.pitch_deg, path);
   if (a.wave_s > 0.0) samples = with_waving(samples, a, path, &walk_start_ns);
   if (!a.write_logs_dir.empty()) {  // what is scored below, replayable with `pdnav replay`
@@ -845,6 +924,10 @@ void register_eval_pdr(CLI::App& app) {
   c->add_option("--wave-amplitude", a->wave_amplitude, "scale of the waving's rotation and translation")
       ->check(CLI::Range(0.0, 3.0))
       ->capture_default_str();
+  c->add_option("--rate", a->rate_hz,
+                 "motion sensors as a phone sampling at most this rate would record them (Hz; each "
+                 "accelerometer / gyroscope / magnetometer stream block-averaged, rotation vectors decimated)")
+      ->check(CLI::Range(5.0, 1000.0));
   c->add_option("--pitch", a->pitch_deg,
                  "every walk with the phone pitched this much further (deg, top edge up) about the walk's "
                  "horizontal lateral axis: the same walk, the phone held at another pitch")

@@ -117,6 +117,15 @@ add_test(NAME pdr_cli_eval_pdr_all
                  --out "${_pdr_tyrex_out}" --pdnav $<TARGET_FILE:pdnav> --data "${PDNAV_SHARED_DATA_DIR}")
 set_tests_properties(pdr_cli_eval_pdr_all PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
                      PASS_REGULAR_EXPRESSION "running pocket/none +1 .*texting/none +1 .*summary tyrex sensors=all: walks 2 median_mean_error_m [0-7]\\.[0-9]+ median_rms_pct [0-9.]+ .* median_step_error_pct ([0-9]|[12][0-9])\\.[0-9] .* beats_naive [0-2] beats_still [0-2] naive_median_mean_error_m [0-9.]+ still_median_mean_error_m [0-9.]+ median_coverage_68 (0\\.[0-9]+|1\\.00) pooled_coverage_68 [01]\\.[0-9]+\n.*summary outdoor sensors=all: walks 1 median_mean_error_m [2-6][0-9]\\.[0-9]+ median_rms_pct [0-9.]+ median_seg_heading_abs_deg [0-9]\\.[0-9] .* median_length_ratio 0\\.[6-9][0-9]+ .* naive_median_mean_error_m - still_median_mean_error_m 1[0-9][0-9]\\.[0-9]+ median_coverage_68 (0\\.[0-9]+|1\\.00) pooled_coverage_68 [01]\\.[0-9]+\n.*summary oxford: walks 6 mean_step_error_pct 0\\.[0-9]+ worst_step_error_pct [0-2]\\.[0-9]+ ")
+# eval-pdr --rate: the 200 Hz TYREX texting walk block-averaged to 50 Hz keeps a quarter of its
+# accelerometer lines (written with --write-logs, 24-26 %), and a rate at or above the
+# recording's leaves the walk as recorded (the per-walk line identical to the one without it).
+add_test(NAME pdr_cli_eval_pdr_rate
+         COMMAND sh -c "d=\"$2\"; rm -rf \"$d\"; mkdir -p \"$d\" || exit 1; \"$0\" eval-pdr --quiet --rate 50 --write-logs \"$d\" \"$1\" >/dev/null 2>&1 || exit 1; n0=$(grep -c '^Accel,' \"$1\"); n1=$(grep -c '^Accel,' \"$d/$(basename \"$1\")\"); echo \"accel lines $n0 -> $n1\"; [ $((400 * n1)) -ge $((96 * n0)) ] && [ $((400 * n1)) -le $((104 * n0)) ] && echo quarter; a=$(\"$0\" eval-pdr --quiet \"$1\" 2>/dev/null | grep '^Guillaume'); b=$(\"$0\" eval-pdr --quiet --rate 1000 \"$1\" 2>/dev/null | grep '^Guillaume'); [ -n \"$a\" ] && [ \"$a\" = \"$b\" ] && echo same"
+                 $<TARGET_FILE:pdnav> "${_pdr_tyrex_out}/logs/tyrex/Guillaume_Nexus5_NoDist_Texting.log"
+                 "${PROJECT_BINARY_DIR}/test-scratch/pdr-rate-logs")
+set_tests_properties(pdr_cli_eval_pdr_rate PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
+                     PASS_REGULAR_EXPRESSION "\nquarter\nsame")
 # --reference fixes on a log without Fix rows (a TYREX recording): a clear error, exit 1
 add_test(NAME pdr_cli_eval_pdr_no_fixes
          COMMAND sh -c "$0 eval-pdr --reference fixes \"$1\" 2>&1; echo rc=$?" $<TARGET_FILE:pdnav>
