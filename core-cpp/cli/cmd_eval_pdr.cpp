@@ -288,13 +288,15 @@ class Runner {
       }
     }
   }
-  void start(const geo::Geodetic& g, TimeNs t_ns, const geo::LocalFrame& frame) {
+  /// sigma_m: the start point's own 1-sigma per axis (a surveyed point 1 m; a phone's fix its
+  /// stated accuracy), so the stated covariance holds the start's error too.
+  void start(const geo::Geodetic& g, TimeNs t_ns, const geo::LocalFrame& frame, double sigma_m) {
     frame_ = frame;
     started_ = true;
     en_ = frame.to_enu(g).p_m.head<2>();
     last_en_ = en_;
     path_m_ = 0;
-    if (nav_) nav_->set_start(g.lat_deg(), g.lon_deg(), 1.0, t_ns);
+    if (nav_) nav_->set_start(g.lat_deg(), g.lon_deg(), sigma_m, t_ns);
     if (pdr_ && wmm_) pdr_->set_location(g, kMissingInt);
   }
   void set_location(const geo::Geodetic& g, std::int64_t utc_ms) {
@@ -618,7 +620,8 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
       if (!std::isfinite(t->lat_deg) || !std::isfinite(t->lon_deg)) continue;
       if (!started) {
         frame = geo::LocalFrame(g);
-        run.start(g, t->t_ns, frame);
+        const auto start_sigma = r.ref_sigma_m.find(t->t_ns);  // the start fix's own error
+        run.start(g, t->t_ns, frame, start_sigma != r.ref_sigma_m.end() ? std::max(1.0, start_sigma->second) : 1.0);
         naive.start(Eigen::Vector2d::Zero());
         started = true;
         // the naive PDR keeps the raw (magnetic) rotation-vector yaw, as the naive
