@@ -88,8 +88,8 @@ struct EvalPdrArgs {
 /// accelerometer only (Oxford); imu = accelerometer, gyroscope, magnetometer; rv = the
 /// rotation vector only (what `pdnav simulate` writes, with its step events); uncal = the
 /// uncalibrated streams (UncalAccel/UncalGyro/UncalMag, the calibrated accelerometer where no
-/// UncalAccel is logged); game = accelerometer, gyroscope, game rotation vector; all = as
-/// recorded. Truth, Meta and step events always pass (the step events are the phone's).
+/// UncalAccel is logged); game = accelerometer, gyroscope, game rotation vector; accelmag =
+/// accelerometer and magnetometer (a phone without a gyroscope); all = as recorded. Truth, Meta and step events always pass (the step events are the phone's).
 bool sensor_set_keeps(const std::string& set, const Sample& s) {
   if (set == "all" || std::holds_alternative<TruthSample>(s) || std::holds_alternative<MetaSample>(s)) return true;
   const bool acc = std::holds_alternative<AccelSample>(s), gyro = std::holds_alternative<GyroSample>(s),
@@ -103,7 +103,8 @@ bool sensor_set_keeps(const std::string& set, const Sample& s) {
   if (set == "rv") return rv || steps;
   if (set == "uncal") return uncal || acc;
   if (set == "game") return acc || gyro || game;
-  throw std::invalid_argument("--sensors: expected all, accel, imu, rv, uncal or game");
+  if (set == "accelmag") return acc || mag;
+  throw std::invalid_argument("--sensors: expected all, accel, imu, rv, uncal, game or accelmag");
 }
 
 /// The naive reference PDR of the issue: low-passed |a| peaks, fixed 0.70 m, RV yaw.
@@ -941,7 +942,7 @@ void register_eval_pdr(CLI::App& app) {
                  "the scored fixes are written as its Truth rows")
       ->check(CLI::ExistingDirectory);
   c->add_flag("--quiet", a->quiet, "one line per walk");
-  c->add_option("--sensors", a->sensors, "sensor set kept from each log: all | accel | imu | rv | uncal | game")
+  c->add_option("--sensors", a->sensors, "sensor set kept from each log: all | accel | imu | rv | uncal | game | accelmag")
       ->capture_default_str();
   c->add_option("--segment-min-m", a->segment_min_m,
                 "a heading segment ends once the truth moved this far along its path (0 = every Truth line)")

@@ -150,12 +150,30 @@ TEST(PdrVehicle, NoRealWalkLosesStepsToTheVehicleClass) {
   }
   std::printf("49 real walks, %lld steps: %lld walks lose steps to the vehicle class\n",
               static_cast<long long>(total), static_cast<long long>(lost_walks));
-  // control: the same options do refuse a ride (so this test fails with the class disabled),
-  // also accelerometer-only (the Oxford case)
+  // control: the same options do refuse a ride (so this test fails with the class disabled)
   RealWalk ride = make_ride(ride_spec(1), 200'000'000'000);
   EXPECT_GT(count(auto_mount(true), ride).refused_vehicle, 0);
+}
+
+TEST(PdrVehicle, WithoutAGyroscopeNoRideIsAVehicle) {
+  // The limit of a phone without a gyroscope: no kinematic evidence (speed changes, turns) can be
+  // had, and the vibration score alone takes a slow shuffle for a ride (TYREX texting, phoning,
+  // the phone held up: carry_direction_test.cpp), so such a phone is never classed vehicle and its
+  // rides count their vibration's steps; the same ride with the gyroscope is refused.
+  RealWalk ride = make_ride(ride_spec(2), 200'000'000'000);
+  const Counted with_gyro = count(auto_mount(true), ride);
   ride.gyro.clear();
-  EXPECT_LE(count(PdrOptions{}, ride).steps, 2u);
+  const Counted accel_only = count(PdrOptions{}, ride);
+  std::printf("the rough-road ride: %zu steps with the gyroscope (state %s), %zu from the accelerometer alone (state %s)\n",
+              with_gyro.steps, to_string(with_gyro.final_state), accel_only.steps, to_string(accel_only.final_state));
+  EXPECT_EQ(with_gyro.final_state, MotionState::kVehicle);
+  EXPECT_LE(with_gyro.steps, 2u);
+  EXPECT_NE(accel_only.final_state, MotionState::kVehicle);
+  EXPECT_EQ(accel_only.refused_vehicle, 0);
+  // the score alone (kinematic evidence off) still classes it
+  PdrOptions score_alone;
+  score_alone.motion.kinematic_min_mps2 = 0.0;
+  EXPECT_EQ(count(score_alone, ride).final_state, MotionState::kVehicle);
 }
 
 TEST(PdrVehicle, AndroidStepEventsDuringARideAreRefused) {

@@ -252,9 +252,9 @@ void MotionClassifier::vehicle_evaluate(TimeNs t_ns) {
   } else {
     vehicle_score_s_ = std::max(0.0, vehicle_score_s_ - opt_.vehicle_decay * opt_.vehicle_eval_s);
   }
-  // with a gyroscope, no vehicle without a speed change or turn no walker makes (the score
-  // waits at the threshold for one)
-  const bool kinematic_ok = opt_.kinematic_min_mps2 <= 0.0 || last_gyro_ns_ < 0 || kinematic_recent(t_ns);
+  // no vehicle without a speed change or turn no walker makes (the score waits at the threshold
+  // for one); without a gyroscope that evidence cannot be had, so the score never enters one
+  const bool kinematic_ok = opt_.kinematic_min_mps2 <= 0.0 || kinematic_recent(t_ns);
   if (vehicle_score_s_ >= opt_.vehicle_enter_s && !kinematic_ok) vehicle_score_s_ = opt_.vehicle_enter_s;
   vehicle_max_score_s_ = std::max(vehicle_max_score_s_, vehicle_score_s_);
   if (vehicle_score_s_ >= opt_.vehicle_enter_s && kinematic_ok) {

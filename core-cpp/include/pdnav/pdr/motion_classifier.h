@@ -112,11 +112,14 @@ struct MotionClassifierOptions {
   // turns slower than vehicle_max_rate_radps: a speed change of >= 2.4 m/s in 3 s (car and bus
   // service accelerations 0.9-1.5 m/s^2, braking 1.2-2), or a turn's v x yaw rate. A walker
   // changes speed by <= 1.5 m/s (standstill to a brisk walk) and turns at <= 0.4 rad/s x 1.5 m/s =
-  // 0.6 m/s^2 under that rate. With a gyroscope the vehicle is entered only when such evidence
-  // lies within kinematic_memory_s (a ride's stops and turns recur within minutes); without one
-  // (accelerometer-only data) the score alone decides, as before. Measured (docs/pdr.md): the
+  // 0.6 m/s^2 under that rate. The vehicle is entered only when such evidence lies within
+  // kinematic_memory_s (a ride's stops and turns recur within minutes). Without a gyroscope
+  // there is no such evidence, and the score alone took the slow shuffles of TYREX (texting,
+  // phoning, the phone held up) for rides from start to end (20-76 % of their steps lost), so a
+  // phone without one is never classed vehicle (its rides count steps). Measured (docs/pdr.md): the
   // synthesised rides reach 1.01-1.76 m/s^2, the shared real walks <= 0.73 but one ILC walk at 1.01
-  // (accelerometer bias and scale leak into the horizontal as a phone is turned). 0 = off.
+  // (accelerometer bias and scale leak into the horizontal as a phone is turned). 0 = off (the
+  // vibration score alone decides, with or without a gyroscope).
   double kinematic_min_mps2 = 0.8;
   double kinematic_window_s = 3.0;
   double kinematic_tilt_tau_s = 10.0;  // gravity's pull toward the accelerometer (gyro drift <= tau x bias)
