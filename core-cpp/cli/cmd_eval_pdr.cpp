@@ -75,6 +75,7 @@ struct EvalPdrArgs {
   double wave_amplitude = 1.0;
   double pitch_deg = 0.0;     // every walk with the phone pitched this much further (0 = as recorded)
   double rate_hz = 0.0;       // motion sensors block-averaged to at most this rate (0 = as recorded)
+  double turn_deg = 0.0;      // every walk with the phone turned this much in the hand about its Z axis
   std::string sensors = "all";  // sensor set kept from each log (sensor_set_keeps)
   double segment_min_m = 0.0;   // 0: a segment per Truth line (surveyed waypoints)
   double align_start_s = 0.0;   // 0: no alignment (absolute tracks)
@@ -361,12 +362,13 @@ std::vector<Sample> read_samples(const std::string& path) {
   return out;
 }
 
+std::vector<Sample> rotated_phone(const std::vector<Sample>& in, const Eigen::AngleAxisd& rot);
+
 /// The walk with the phone pitched --pitch degrees further, top edge up, about the walk's
 /// horizontal lateral axis (+Y x the mean gravity, phone axes): the same physical walk with the
 /// phone held at another pitch, the top edge's heading kept (a reader holds a phone at 28-65 deg,
-/// issue 27). Every phone-axes stream is rotated: v' = R^T v for the accelerometer, gyroscope and
-/// magnetometer (and their uncalibrated twins with their biases), q' = q R for the rotation
-/// vectors; the Android orientation angles are dropped (they would be stale).
+/// issue 27).
+
 std::vector<Sample> with_pitch(const std::vector<Sample>& in, double pitch_deg, const std::string& path) {
   Eigen::Vector3d up = Eigen::Vector3d::Zero();
   for (const Sample& s : in)
@@ -374,7 +376,21 @@ std::vector<Sample> with_pitch(const std::vector<Sample>& in, double pitch_deg, 
   const Eigen::Vector3d lateral = Eigen::Vector3d::UnitY().cross(up);
   if (!(up.norm() > 0.0) || lateral.norm() < 0.1 * up.norm())
     throw std::runtime_error(path + ": --pitch needs accelerometer samples and a phone whose +Y axis is not vertical on average");
-  const Eigen::AngleAxisd rot(pitch_deg * kDegToRad, lateral.normalized());  // the new phone axes in the old ones
+  return rotated_phone(in, Eigen::AngleAxisd(pitch_deg * kDegToRad, lateral.normalized()));
+}
+
+/// The walk with the phone turned --turn degrees in the hand about its own Z axis (the screen's
+/// normal; + = counter-clockwise seen from the screen): 90 holds a phone held for texting in
+/// landscape, its walking direction along -X instead of +Y.
+std::vector<Sample> with_turn(const std::vector<Sample>& in, double turn_deg) {
+  return rotated_phone(in, Eigen::AngleAxisd(turn_deg * kDegToRad, Eigen::Vector3d::UnitZ()));
+}
+
+/// Every phone-axes stream of the walk with the phone rotated by rot (the new phone axes in the
+/// old ones): v' = R^T v for the accelerometer, gyroscope and magnetometer (and their
+/// uncalibrated twins with their biases), q' = q R for the rotation vectors; the Android
+/// orientation angles are dropped (they would be stale).
+std::vector<Sample> rotated_phone(const std::vector<Sample>& in, const Eigen::AngleAxisd& rot) {
   const Eigen::Matrix3d rt = rot.toRotationMatrix().transpose();
   const Eigen::Quaterniond qr(rot);
   const auto turn_q = [&](Eigen::Vector4d& xyzw) {
@@ -582,6 +598,7 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   }
   TimeNs walk_start_ns = std::numeric_limits<TimeNs>::min();
   if (a.rate_hz > 0.0) samples = with_rate(samples, a.rate_hz);
+  if (a.turn_deg != 0.0) samples = with_turn(samples, a.turn_deg);
   if (a.pitch_deg != 0.0) samples = with_pitch(samples, a.pitch_deg, path);
   if (a.wave_s > 0.0) samples = with_waving(samples, a, path, &walk_start_ns);
   if (!a.write_logs_dir.empty()) {  // what is scored below, replayable with `pdnav replay`
@@ -932,6 +949,10 @@ void register_eval_pdr(CLI::App& app) {
                  "motion sensors as a phone sampling at most this rate would record them (Hz; each "
                  "accelerometer / gyroscope / magnetometer stream block-averaged, rotation vectors decimated)")
       ->check(CLI::Range(5.0, 1000.0));
+  c->add_option("--turn", a->turn_deg,
+                 "every walk with the phone turned this much in the hand about its screen's normal (deg, + = "
+                 "counter-clockwise seen from the screen; 90 = held in landscape): the same walk, another grip")
+      ->check(CLI::Range(-180.0, 180.0));
   c->add_option("--pitch", a->pitch_deg,
                  "every walk with the phone pitched this much further (deg, top edge up) about the walk's "
                  "horizontal lateral axis: the same walk, the phone held at another pitch")

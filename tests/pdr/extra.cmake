@@ -126,6 +126,15 @@ add_test(NAME pdr_cli_eval_pdr_rate
                  "${PROJECT_BINARY_DIR}/test-scratch/pdr-rate-logs")
 set_tests_properties(pdr_cli_eval_pdr_rate PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
                      PASS_REGULAR_EXPRESSION "\nquarter\nsame")
+# eval-pdr --turn: the phone turned 90 deg in the hand (counter-clockwise seen from the screen):
+# every phone-axes vector is R^T v, so the written log's first accelerometer line is
+# (a_y, -a_x, a_z) of the recorded one (to 1e-4 m/s^2).
+add_test(NAME pdr_cli_eval_pdr_turn
+         COMMAND sh -c "d=\"$2\"; rm -rf \"$d\"; mkdir -p \"$d\" || exit 1; \"$0\" eval-pdr --quiet --turn 90 --write-logs \"$d\" \"$1\" >/dev/null 2>&1 || exit 1; a=$(grep -m1 '^Accel,' \"$1\"); b=$(grep -m1 '^Accel,' \"$d/$(basename \"$1\")\"); echo \"recorded $a\"; echo \"turned   $b\"; echo \"$a $b\" | awk -F'[ ,]' '{dx=$10-$5; dy=$11+$4; dz=$12-$6; if (dx*dx+dy*dy+dz*dz < 1e-8) print \"rotated\"}'"
+                 $<TARGET_FILE:pdnav> "${_pdr_tyrex_out}/logs/tyrex/Guillaume_Nexus5_NoDist_Texting.log"
+                 "${PROJECT_BINARY_DIR}/test-scratch/pdr-turn-logs")
+set_tests_properties(pdr_cli_eval_pdr_turn PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
+                     PASS_REGULAR_EXPRESSION "\nrotated")
 # --reference fixes on a log without Fix rows (a TYREX recording): a clear error, exit 1
 add_test(NAME pdr_cli_eval_pdr_no_fixes
          COMMAND sh -c "$0 eval-pdr --reference fixes \"$1\" 2>&1; echo rc=$?" $<TARGET_FILE:pdnav>
