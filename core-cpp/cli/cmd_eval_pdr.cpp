@@ -27,6 +27,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -580,7 +581,34 @@ std::vector<Sample> fixes_as_reference(const std::vector<Sample>& in, double max
   return out;
 }
 
-WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
+/// The --write-logs file of each input: its file name (+ .log) in the folder, "-2", "-3", ...
+/// before the extension when two inputs share a name; an input the name would overwrite is an
+/// error (a recorded session is never written over).
+std::vector<std::string> written_log_paths(const EvalPdrArgs& a) {
+  std::vector<std::string> out;
+  if (a.write_logs_dir.empty()) return out;
+  std::set<std::string> used;
+  for (const std::string& log : a.logs) {
+    std::string base = std::filesystem::path(log).filename().string();  // a file, a folder or a zip
+    if (base.empty()) base = std::filesystem::path(log).parent_path().filename().string();  // "dir/"
+    if (base.size() >= 4 && base.compare(base.size() - 4, 4, ".log") == 0) base.resize(base.size() - 4);
+    std::string name = base + ".log";
+    for (int k = 2; used.count(name); ++k) name = base + "-" + std::to_string(k) + ".log";
+    if (name != base + ".log") std::cerr << "eval-pdr: " << log << " is written as " << name << " (another input has its name)\n";
+    used.insert(name);
+    const std::filesystem::path target = std::filesystem::path(a.write_logs_dir) / name;
+    std::error_code ec;
+    if (std::filesystem::exists(target, ec))
+      for (const std::string& input : a.logs)
+        if (std::filesystem::equivalent(target, input, ec))
+          throw std::invalid_argument("--write-logs: " + target.string() + " is the input " + input +
+                                      ": write the evaluated walks to another folder");
+    out.push_back(target.string());
+  }
+  return out;
+}
+
+WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a, const std::string& write_path) {
   WalkResult r;
   r.name = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
   std::vector<Sample> samples = read_samples(path);
@@ -601,10 +629,8 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a) {
   if (a.turn_deg != 0.0) samples = with_turn(samples, a.turn_deg);
   if (a.pitch_deg != 0.0) samples = with_pitch(samples, a.pitch_deg, path);
   if (a.wave_s > 0.0) samples = with_waving(samples, a, path, &walk_start_ns);
-  if (!a.write_logs_dir.empty()) {  // what is scored below, replayable with `pdnav replay`
-    std::string base = std::filesystem::path(path).filename().string();  // a file, a folder or a zip
-    if (base.size() < 4 || base.compare(base.size() - 4, 4, ".log") != 0) base += ".log";
-    io::LogWriter w(a.write_logs_dir + "/" + base);
+  if (!write_path.empty()) {  // what is scored below, replayable with `pdnav replay`
+    io::LogWriter w(write_path);
     for (const Sample& s : samples)
       if (sensor_set_keeps(a.sensors, s)) w.write(s);
     w.close();
@@ -837,12 +863,14 @@ int run_eval_pdr(const EvalPdrArgs& a) {
     json.open(a.json_out);
     if (!json) throw std::runtime_error("--json: cannot write " + a.json_out);
   }
+  const std::vector<std::string> written = written_log_paths(a);
   std::size_t done = 0;
   for (const std::string& log : a.logs) {
+    const std::string write_path = written.empty() ? std::string() : written[done];
     ++done;
     if (!a.json_out.empty()) std::cerr << "eval-pdr: [" << done << "/" << a.logs.size() << "] " << log << "\n";
     try {
-      all.push_back(eval_walk(log, a));
+      all.push_back(eval_walk(log, a, write_path));
     } catch (const std::exception& e) {
       std::cerr << "eval-pdr: " << e.what() << "\n";
       ++failed;
@@ -959,7 +987,8 @@ void register_eval_pdr(CLI::App& app) {
       ->check(CLI::Range(-80.0, 80.0));
   c->add_option("--write-logs", a->write_logs_dir,
                  "write each walk as evaluated (pitched, waved, sensor set kept) as a session log in this "
-                 "existing folder, under its input's file name (+ .log), to replay or plot; with --reference fixes "
+                 "existing folder, under its input's file name (+ .log; -2, -3 ... for inputs of the same name; never over an "
+                 "input), to replay or plot; with --reference fixes "
                  "the scored fixes are written as its Truth rows")
       ->check(CLI::ExistingDirectory);
   c->add_flag("--quiet", a->quiet, "one line per walk");

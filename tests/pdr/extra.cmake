@@ -93,6 +93,15 @@ add_test(NAME pdr_cli_eval_pdr_write_logs
                  "${PROJECT_BINARY_DIR}/test-scratch/pdr-written-logs")
 set_tests_properties(pdr_cli_eval_pdr_write_logs PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_ilc
                      PASS_REGULAR_EXPRESSION "\nsame")
+# --write-logs never writes over a recording: two inputs of the same name are written as x.log
+# and x-2.log (said on stderr), and a folder where a written log would replace an input is an
+# error (exit 1) that leaves the input as it was.
+add_test(NAME pdr_cli_eval_pdr_write_logs_names
+         COMMAND sh -c "d=\"$2\"; rm -rf \"$d\"; mkdir -p \"$d/a\" \"$d/b\" \"$d/out\" || exit 1; cp \"$1\" \"$d/a/x.log\" && cp \"$1\" \"$d/b/x.log\" || exit 1; \"$0\" eval-pdr --quiet --write-logs \"$d/out\" \"$d/a/x.log\" \"$d/b/x.log\" 2>&1 >/dev/null | grep 'written as'; ls \"$d/out\"; \"$0\" eval-pdr --quiet --write-logs \"$d/a\" \"$d/a/x.log\" >/dev/null 2>&1; echo rc=$?; cmp -s \"$1\" \"$d/a/x.log\" && echo input-intact"
+                 $<TARGET_FILE:pdnav> "${_pdr_ilc_out}/site2_F3_5dd38fff44333f00067aa387.log"
+                 "${PROJECT_BINARY_DIR}/test-scratch/pdr-written-names")
+set_tests_properties(pdr_cli_eval_pdr_write_logs_names PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_ilc
+                     PASS_REGULAR_EXPRESSION "b/x\\.log is written as x-2\\.log \\(another input has its name\\)\nx-2\\.log\nx\\.log\nrc=1\ninput-intact")
 # Issue 27: two TYREX motion-capture recordings converted by tools/tyrex2log (steps counted from
 # the capture: the slow texting walk ~1.15 Hz, the run 2.72 Hz, matching the phone's own
 # accelerometer spectrum; the count within 10 % of the two independent counts it prints, the
