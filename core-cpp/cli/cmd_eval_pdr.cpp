@@ -48,6 +48,7 @@
 #include "pdnav/io/sample_source.h"
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/phonesim/handling.h"
+#include "support/output_file.h"
 #include "support/replay_support.h"
 
 namespace pdnav::cli {
@@ -630,10 +631,12 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a, const std::s
   if (a.pitch_deg != 0.0) samples = with_pitch(samples, a.pitch_deg, path);
   if (a.wave_s > 0.0) samples = with_waving(samples, a, path, &walk_start_ns);
   if (!write_path.empty()) {  // what is scored below, replayable with `pdnav replay`
-    io::LogWriter w(write_path);
+    OutputFile out(write_path, a.logs);
+    io::LogWriter w(out.partial_path());
     for (const Sample& s : samples)
       if (sensor_set_keeps(a.sensors, s)) w.write(s);
     w.close();
+    out.commit();
   }
   Runner run(a);
   NaivePdr naive;

@@ -13,6 +13,7 @@
 #include "pdnav/io/log_format.h"
 #include "pdnav/io/log_writer.h"
 #include "pdnav/io/sample_source.h"
+#include "support/output_file.h"
 #include "support/sources.h"
 
 namespace pdnav::cli {
@@ -33,10 +34,12 @@ void run_import(const ImportArgs& a) {
   const auto& info = src->header_info();
   for (const char* k : {"device name", "deviceModel", "Model"})
     if (auto it = info.find(k); it != info.end() && wopt.device.empty()) wopt.device = it->second;
-  io::LogWriter writer(a.out, wopt);
+  OutputFile out(a.out, {a.in});
+  io::LogWriter writer(out.partial_path(), wopt);
   Sample s;
   while (src->next(s)) writer.write(s);
   writer.close();
+  out.commit();
   const io::ReadStats& st = src->stats();
   std::printf("%s (%s) -> %s: %lld samples, %lld lines written\n", a.in.c_str(),
               std::string(io::format_name(src->format())).c_str(), a.out.c_str(), static_cast<long long>(st.samples),

@@ -73,3 +73,13 @@ foreach(_fx phyphox-walk getsensordata-walk.txt)
            COMMAND "${CMAKE_COMMAND}" -E compare_files "${_d}-direct/track.csv" "${_d}-imported/track.csv")
   set_tests_properties(io_import_replay_identical_${_n} PROPERTIES LABELS "io;cli" FIXTURES_REQUIRED io_imp_replayed_${_n})
 endforeach()
+
+# `pdnav import` never loses a recording: importing a log onto itself is refused (exit 1) and
+# leaves it byte for byte; an import that fails after writing began (--strict and a malformed
+# last line) leaves an existing output as it was and no NAME.partial behind.
+add_test(NAME io_import_never_over_a_recording
+         COMMAND sh -c "d=\"$2\"; rm -rf \"$d\"; mkdir -p \"$d\" || exit 1; \"$0\" import \"$1\" -o \"$d/x.log\" >/dev/null || exit 1; cp \"$d/x.log\" \"$d/copy.log\"; \"$0\" import \"$d/x.log\" -o \"$d/x.log\" >/dev/null 2>&1; echo rc=$?; cmp -s \"$d/x.log\" \"$d/copy.log\" && echo self-intact; cp \"$d/x.log\" \"$d/bad.log\" && echo 'Accel,1,2,x,y,z' >> \"$d/bad.log\"; \"$0\" import --strict \"$d/bad.log\" -o \"$d/copy.log\" >/dev/null 2>&1; echo rc=$?; cmp -s \"$d/x.log\" \"$d/copy.log\" && echo output-intact; ls \"$d\" | grep -c partial"
+         $<TARGET_FILE:pdnav> "${PROJECT_SOURCE_DIR}/tests/data/loggers/getsensordata-walk.txt"
+         "${CMAKE_CURRENT_BINARY_DIR}/import-never-over")
+set_tests_properties(io_import_never_over_a_recording PROPERTIES LABELS "io;cli"
+  PASS_REGULAR_EXPRESSION "rc=1\nself-intact\nrc=1\noutput-intact\n0\n")
