@@ -29,7 +29,7 @@ struct SourceRun {
 /// Feeds the walk in time order; rotation-vector samples inside [cut_from, cut_to) are dropped;
 /// with `field_ut` a magnetometer sample of that (phone-axes) field accompanies every rotation
 /// vector sample.
-SourceRun feed(const RealWalk& w, TimeNs cut_from, TimeNs cut_to, const Eigen::Vector3d* field_ut) {
+SourceRun feed(const RealWalk& w, TimeNs cut_from, TimeNs cut_to, const Eigen::Vector3d* field_ut, bool with_gyro = true) {
   PdrOptions o;
   o.heading.mount = Mount::kAuto;
   Pdr p(o);
@@ -37,7 +37,7 @@ SourceRun feed(const RealWalk& w, TimeNs cut_from, TimeNs cut_to, const Eigen::V
   SourceRun r;
   std::size_t ig = 0, ir = 0;
   for (const auto& s : w.accel) {
-    while (ig < w.gyro.size() && w.gyro[ig].t_ns <= s.t_ns) p.feed(w.gyro[ig++]);
+    while (with_gyro && ig < w.gyro.size() && w.gyro[ig].t_ns <= s.t_ns) p.feed(w.gyro[ig++]);
     while (ir < w.rotation.size() && w.rotation[ir].t_ns <= s.t_ns) {
       const RotationVectorSample& rv = w.rotation[ir++];
       if (rv.t_ns >= cut_from && rv.t_ns < cut_to) continue;
@@ -101,4 +101,17 @@ TEST(PdrHeadingSource, ADisturbedFieldHandsTheHeadingToTheGyro) {
   ASSERT_GT(total(r), 40);
   EXPECT_EQ(steps_with(r, HeadingSource::kGyro), total(r));
   EXPECT_EQ(steps_with(r, HeadingSource::kRotationVector), 0);
+}
+
+TEST(PdrHeadingSource, WithoutAGyroscopeTheFollowedStreamIsTheSource) {
+  // the same disturbed walk from a phone without a gyroscope: nothing holds the heading through
+  // the disturbance, the heading follows the absolute stream (HeadingFusionOptions::no_gyro_tau_s)
+  // whatever its weight, so that stream is the source, never "gyro" (summary.json used to say
+  // gyro on logs without one)
+  const RealWalk walk = read_ilc(pdnav::test::shared_data(kWalk));
+  const Eigen::Vector3d disturbed(60.0, 40.0, -50.0);
+  const SourceRun r = feed(walk, 0, 0, &disturbed, false);
+  ASSERT_GT(total(r), 40);
+  EXPECT_EQ(steps_with(r, HeadingSource::kGyro), 0);
+  EXPECT_EQ(steps_with(r, HeadingSource::kRotationVector), total(r));
 }

@@ -115,6 +115,10 @@ const char* to_string(HeadingSource s) {
 
 HeadingSource Pdr::heading_source(TimeNs t_ns) const {
   if (!fusion_.valid() || abs_weight_ns_ < 0) return HeadingSource::kInitial;
+  // without a live gyroscope the heading follows the absolute stream whatever its weight
+  // (HeadingFusionOptions::no_gyro_tau_s): that stream is the source, never "gyro"
+  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
+  if (!gyro_live) return abs_kind_;
   // the mean weight decays toward 0 while no reading arrives: the gyro alone carries it then
   const double age_s = std::max(0.0, ns_to_s(t_ns - abs_weight_ns_));
   const double w = abs_weight_mean_ * std::exp(-age_s / opt_.source_tau_s);
