@@ -430,12 +430,15 @@ std::vector<Sample> with_rate(const std::vector<Sample>& in, double rate_hz) {
   const TimeNs block_ns = static_cast<TimeNs>(std::llround(1e9 / rate_hz));
   struct Block {
     bool open = false;
-    TimeNs start_ns = 0;
+    TimeNs cell = 0;  // the block's cell on the grid
     int n = 0;
     Sample last;
     Eigen::Vector3d sum_a = Eigen::Vector3d::Zero(), sum_b = Eigen::Vector3d::Zero();
   };
   std::array<Block, std::variant_size_v<Sample>> blocks;
+  constexpr TimeNs kNoGrid = std::numeric_limits<TimeNs>::min();
+  std::array<TimeNs, std::variant_size_v<Sample>> grid0_ns;
+  grid0_ns.fill(kNoGrid);
   std::vector<Sample> out;
   out.reserve(in.size());
   const auto vectors = [](const Sample& s, Eigen::Vector3d* a, Eigen::Vector3d* b) -> bool {
@@ -481,8 +484,12 @@ std::vector<Sample> with_rate(const std::vector<Sample>& in, double rate_hz) {
     }
     Block& b = blocks[s.index()];
     const TimeNs t = sample_time_ns(s);
-    if (b.open && (t - b.start_ns >= block_ns || t < b.start_ns)) flush(b);
-    if (!b.open) b.open = true, b.start_ns = t;
+    // blocks on a fixed grid of 1 / rate from the stream's first sample: the output rate is the
+    // rate asked for whatever the input's (a block of 2 or 3 samples alternates at 50 -> 20 Hz)
+    if (grid0_ns[s.index()] == kNoGrid) grid0_ns[s.index()] = t;
+    const TimeNs cell = t >= grid0_ns[s.index()] ? (t - grid0_ns[s.index()]) / block_ns : -1;
+    if (b.open && (cell != b.cell || cell < 0)) flush(b);
+    if (!b.open) b.open = true, b.cell = cell;
     if (vec && va.allFinite() && vb.allFinite()) {
       b.sum_a += va, b.sum_b += vb, ++b.n, b.last = s;
     } else if (!vec) {

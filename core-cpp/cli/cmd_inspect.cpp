@@ -11,6 +11,8 @@
 #include "pdnav/io/log_format.h"
 #include "pdnav/io/log_reader.h"
 #include "pdnav/io/sample_source.h"
+#include "pdnav/pdr/pdr.h"
+#include "support/replay_support.h"
 #include "support/sources.h"
 
 namespace pdnav::cli {
@@ -117,6 +119,12 @@ void run_inspect(const InspectArgs& a) {
   for (const auto& [k, v] : reader.header_info()) std::printf(" %s=%s;", k.c_str(), v.c_str());
   std::printf("\nlines: %lld\n", static_cast<long long>(st.lines));
   print_types(types);
+  for (const char* accel : {"Accel", "UncalAccel"}) {  // the step detector needs its rate
+    const auto it = types.find(accel);
+    if (it == types.end() || it->second.distinct_t < 2 || it->second.last_t <= it->second.first_t) continue;
+    const double rate_hz = static_cast<double>(it->second.distinct_t - 1) / (static_cast<double>(it->second.last_t - it->second.first_t) * 1e-9);
+    if (rate_hz < pdr::Pdr::kMinAccelRateHz) std::printf("warning: %s\n", accel_rate_warning(rate_hz).c_str());
+  }
   if (any)
     std::printf("time span: %.6f s .. %.6f s (%.3f s)\n", static_cast<double>(t_min) * 1e-9,
                 static_cast<double>(t_max) * 1e-9, static_cast<double>(t_max - t_min) * 1e-9);

@@ -194,6 +194,8 @@ int run_replay(const ReplayArgs& a) {
       std::cout << (i ? ", " : "") << f1(p["vehicle_spans"][i]["start_s"].get<double>()) << "-"
                 << f1(p["vehicle_spans"][i]["end_s"].get<double>()) << " s";
     std::cout << "; longest step delay " << f1(p["max_step_delay_s"].get<double>()) << " s\n";
+    if (!p["accel_rate_warning"].get<std::string>().empty())
+      std::cout << "warning:  " << p["accel_rate_warning"].get<std::string>() << "\n";
   }
   std::cout << "epochs:   " << rec.epochs().size() << "\n";
   std::cout << "mode changes: " << nav.output(0).mode_change_count << " (summary.json fusion.mode_changes)\n";

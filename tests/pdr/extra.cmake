@@ -144,6 +144,15 @@ add_test(NAME pdr_cli_eval_pdr_turn
                  "${PROJECT_BINARY_DIR}/test-scratch/pdr-turn-logs")
 set_tests_properties(pdr_cli_eval_pdr_turn PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
                      PASS_REGULAR_EXPRESSION "\nrotated")
+# A recording whose accelerometer runs below 40 Hz (the step detector is measured at 50-200 Hz):
+# `inspect` and `replay` say so (the TYREX texting walk at 20 Hz: the rate on the grid exactly;
+# at 200 Hz neither warns).
+add_test(NAME pdr_cli_slow_accelerometer_warning
+         COMMAND sh -c "d=\"$2\"; rm -rf \"$d\"; mkdir -p \"$d\" || exit 1; \"$0\" eval-pdr --quiet --rate 20 --write-logs \"$d\" \"$1\" >/dev/null 2>&1 || exit 1; f=\"$d/$(basename \"$1\")\"; \"$0\" inspect \"$f\" | grep -E '^Accel |^warning'; \"$0\" replay --engine dr \"$f\" --out \"$d/out\" 2>/dev/null | grep '^warning'; \"$0\" inspect \"$1\" | grep -c '^warning'"
+                 $<TARGET_FILE:pdnav> "${_pdr_tyrex_out}/logs/tyrex/Guillaume_Nexus5_NoDist_Texting.log"
+                 "${PROJECT_BINARY_DIR}/test-scratch/pdr-slow-accel")
+set_tests_properties(pdr_cli_slow_accelerometer_warning PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
+                     PASS_REGULAR_EXPRESSION "Accel [^\n]* 20\\.00[0-9] *\nwarning: accelerometer at 20 Hz: [^\n]*record at 50 Hz or more\nwarning:  accelerometer at 20 Hz[^\n]*\n0\n")
 # --reference fixes on a log without Fix rows (a TYREX recording): a clear error, exit 1
 add_test(NAME pdr_cli_eval_pdr_no_fixes
          COMMAND sh -c "$0 eval-pdr --reference fixes \"$1\" 2>&1; echo rc=$?" $<TARGET_FILE:pdnav>

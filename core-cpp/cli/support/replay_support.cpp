@@ -1,5 +1,6 @@
 #include "support/replay_support.h"
 
+#include <cstdio>
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -317,6 +318,15 @@ nlohmann::json pdr_calibration_json(const fusion::PdrCalibration& c) {
           {"positions_used", c.positions_used}};
 }
 
+std::string accel_rate_warning(double rate_hz) {
+  char b[256];
+  std::snprintf(b, sizeof b,
+                "accelerometer at %.0f Hz: the step detector is measured at 50-200 Hz and misses steps below %.0f Hz "
+                "(TYREX at 25 Hz: median step error 10 %%, length ratio 0.83; at 10 Hz 0.28); record at 50 Hz or more",
+                rate_hz, pdr::Pdr::kMinAccelRateHz);
+  return b;
+}
+
 nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_steps, TimeNs t0_ns) {
   nlohmann::json j;
   j["steps"] = navigator_steps;
@@ -325,6 +335,11 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
   // issue 27: which sensors the PDR had and the absolute heading they can give
   j["sensor_set"] = pdr.sensor_set().name();
   j["heading_reference"] = pdr.sensor_set().heading_reference();
+  const double rate_hz = pdr.accel_rate_hz();
+  j["accel_rate_hz"] = std::isfinite(rate_hz) ? nlohmann::json(rate_hz) : nlohmann::json();
+  j["accel_rate_warning"] = std::isfinite(rate_hz) && rate_hz < pdr::Pdr::kMinAccelRateHz
+                                ? accel_rate_warning(rate_hz)
+                                : std::string();
   const pdr::PdrCounters c = pdr.counters();
   j["steps_refused_handling"] = c.steps_discarded_by_motion;
   j["steps_dropped_by_bout_gate"] = c.steps_discarded_by_bout_gate;

@@ -109,6 +109,8 @@ class ReplayRecorder {
 /// of step lengths), placement bouts with their time spans (s from the first sample) and
 /// walking direction in phone axes, steps refused by the motion classifier.
 nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_steps, TimeNs t0_ns);
+/// What `replay` and `inspect` say of an accelerometer slower than pdr::Pdr::kMinAccelRateHz.
+std::string accel_rate_warning(double rate_hz);
 
 /// A PDR calibration (fusion::PdrCalibrator) in summary.json / eval-outage JSON: scale and
 /// heading bias with their sigmas, the window's epochs and baseline, the residual correlation

@@ -177,6 +177,9 @@ void Pdr::feed(const AccelSample& s) {
     qsf_.reset();
   }
   have_accel_ = true;
+  if (first_accel_ns_ < 0) first_accel_ns_ = s.t_ns;
+  last_accel_ns_ = std::max(last_accel_ns_, s.t_ns);
+  ++accel_fed_;
   last_cal_accel_ns_ = s.t_ns;
   latest_ns_ = std::max(latest_ns_, s.t_ns);  // "now" for the steps the waits below release
   tracker_.feed(s);
@@ -639,6 +642,11 @@ double Pdr::heading_rad() const {
   const double offset = opt_.heading.mount == Mount::kAuto ? placement_.forward_offset_rad() : 0.0;
   if (!fusion_.valid()) return wrap_two_pi(opt_.heading.initial_heading_rad - yaw + offset);
   return wrap_two_pi(fusion_.heading_mag_rad(yaw, latest_ns_) + offset + declination_rad_);
+}
+
+double Pdr::accel_rate_hz() const {
+  if (accel_fed_ < 2 || first_accel_ns_ < 0 || last_accel_ns_ <= first_accel_ns_) return kNaN;
+  return static_cast<double>(accel_fed_ - 1) / ns_to_s(last_accel_ns_ - first_accel_ns_);
 }
 
 double Pdr::heading_sigma_rad() const {

@@ -214,6 +214,10 @@ class Pdr {
   bool has_location() const { return has_location_; }
   PdrCounters counters() const;
   const PdrSensorSet& sensor_set() const { return sensors_; }
+  /// The accelerometer's mean sample rate so far (Hz; NaN before two samples). The step detector
+  /// is measured at 50-200 Hz: below kMinAccelRateHz it misses steps (docs/pdr.md "Sample rate").
+  double accel_rate_hz() const;
+  static constexpr double kMinAccelRateHz = 40.0;
   StepConsistency consistency() const;
   const PdrOptions& options() const { return opt_; }
   /// Placement bouts so far (time spans, placement, walking direction in phone axes); with a
@@ -288,6 +292,8 @@ class Pdr {
   bool have_rv_up_ = false;
   Eigen::Vector3d rv_up_phone_ = Eigen::Vector3d::UnitZ();
   TimeNs last_cal_accel_ns_ = -1, last_cal_gyro_ns_ = -1, last_cal_mag_ns_ = -1;
+  TimeNs first_accel_ns_ = -1, last_accel_ns_ = -1;  // the accelerometer's rate (accel_rate_hz),
+  std::int64_t accel_fed_ = 0;                          // calibrated or bias-removed
   TimeNs first_uncal_accel_ns_ = -1, first_uncal_gyro_ns_ = -1, first_uncal_mag_ns_ = -1;
   /// An uncalibrated sample is used once its stream has run uncal_fallback_s without its
   /// calibrated twin (never mixed with it: a log with both uses the calibrated one only).
