@@ -8,8 +8,8 @@
 // capture, tools/tyrex2log) use --segment-min-m (a segment ends once the truth has moved that
 // far along its path) and --align-start-s (the track rotated about the start to fit the truth
 // over the first seconds: relative heading, the issue's RMS % of distance). --sensors keeps
-// one sensor set of the log (accel, imu, rv, uncal, game, all); --rate, --pitch and --wave
-// replay the walk as another phone, grip or start would give it; --json writes one object per
+// one sensor set of the log (accel, imu, rv, uncal, game, accelmag, all); --rate, --turn,
+// --pitch and --wave replay the walk as another phone, grip or start would give it; --json writes one object per
 // walk (Meta Carry/Gait/Disturbance/TruthSteps included) for tools/eval-pdr-all.
 // Last line: `median_mean_error_m: X median_length_ratio: Y`.
 //   --via navigator (default): fusion::Navigator in dead-reckoning mode, exactly what
@@ -92,7 +92,8 @@ struct EvalPdrArgs {
 /// rotation vector only (what `pdnav simulate` writes, with its step events); uncal = the
 /// uncalibrated streams (UncalAccel/UncalGyro/UncalMag, the calibrated accelerometer where no
 /// UncalAccel is logged); game = accelerometer, gyroscope, game rotation vector; accelmag =
-/// accelerometer and magnetometer (a phone without a gyroscope); all = as recorded. Truth, Meta and step events always pass (the step events are the phone's).
+/// accelerometer and magnetometer (a phone without a gyroscope); all = as recorded. Truth, Meta
+/// and step events always pass (the step events are the phone's).
 bool sensor_set_keeps(const std::string& set, const Sample& s) {
   if (set == "all" || std::holds_alternative<TruthSample>(s) || std::holds_alternative<MetaSample>(s)) return true;
   const bool acc = std::holds_alternative<AccelSample>(s), gyro = std::holds_alternative<GyroSample>(s),
@@ -370,7 +371,6 @@ std::vector<Sample> rotated_phone(const std::vector<Sample>& in, const Eigen::An
 /// horizontal lateral axis (+Y x the mean gravity, phone axes): the same physical walk with the
 /// phone held at another pitch, the top edge's heading kept (a reader holds a phone at 28-65 deg,
 /// issue 27).
-
 std::vector<Sample> with_pitch(const std::vector<Sample>& in, double pitch_deg, const std::string& path) {
   Eigen::Vector3d up = Eigen::Vector3d::Zero();
   for (const Sample& s : in)
@@ -426,6 +426,23 @@ std::vector<Sample> rotated_phone(const std::vector<Sample>& in, const Eigen::An
 /// sample's time (an output data rate with its anti-alias averaging, what a sensor hub
 /// delivers at a lower rate); the rotation vectors and orientation angles keep the last sample
 /// of each block; every other line as recorded. A stream already at or below the rate is kept.
+/// The vectors --rate averages in a motion-sensor sample: the reading and, for the uncalibrated
+/// streams, its bias / drift (nullptr for the calibrated ones); {nullptr, nullptr} for any other line.
+std::pair<Eigen::Vector3d*, Eigen::Vector3d*> motion_vectors(Sample& s) {
+  return std::visit(
+      [](auto& x) -> std::pair<Eigen::Vector3d*, Eigen::Vector3d*> {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, AccelSample>) return {&x.acc_mps2, nullptr};
+        else if constexpr (std::is_same_v<T, GyroSample>) return {&x.rate_radps, nullptr};
+        else if constexpr (std::is_same_v<T, MagSample>) return {&x.field_ut, nullptr};
+        else if constexpr (std::is_same_v<T, UncalAccelSample>) return {&x.acc_mps2, &x.bias_mps2};
+        else if constexpr (std::is_same_v<T, UncalGyroSample>) return {&x.rate_radps, &x.drift_radps};
+        else if constexpr (std::is_same_v<T, UncalMagSample>) return {&x.field_ut, &x.bias_ut};
+        else return {nullptr, nullptr};
+      },
+      s);
+}
+
 std::vector<Sample> with_rate(const std::vector<Sample>& in, double rate_hz) {
   const TimeNs block_ns = static_cast<TimeNs>(std::llround(1e9 / rate_hz));
   struct Block {
@@ -441,45 +458,24 @@ std::vector<Sample> with_rate(const std::vector<Sample>& in, double rate_hz) {
   grid0_ns.fill(kNoGrid);
   std::vector<Sample> out;
   out.reserve(in.size());
-  const auto vectors = [](const Sample& s, Eigen::Vector3d* a, Eigen::Vector3d* b) -> bool {
-    return std::visit(
-        [&](const auto& x) -> bool {
-          using T = std::decay_t<decltype(x)>;
-          if constexpr (std::is_same_v<T, AccelSample>) return *a = x.acc_mps2, *b = Eigen::Vector3d::Zero(), true;
-          else if constexpr (std::is_same_v<T, GyroSample>) return *a = x.rate_radps, *b = Eigen::Vector3d::Zero(), true;
-          else if constexpr (std::is_same_v<T, MagSample>) return *a = x.field_ut, *b = Eigen::Vector3d::Zero(), true;
-          else if constexpr (std::is_same_v<T, UncalAccelSample>) return *a = x.acc_mps2, *b = x.bias_mps2, true;
-          else if constexpr (std::is_same_v<T, UncalGyroSample>) return *a = x.rate_radps, *b = x.drift_radps, true;
-          else if constexpr (std::is_same_v<T, UncalMagSample>) return *a = x.field_ut, *b = x.bias_ut, true;
-          else return false;
-        },
-        s);
-  };
   const auto flush = [&](Block& b) {
     if (!b.open) return;
     Sample s = b.last;
-    const Eigen::Vector3d ma = b.sum_a / b.n, mb = b.sum_b / b.n;
-    std::visit(
-        [&](auto& x) {
-          using T = std::decay_t<decltype(x)>;
-          if constexpr (std::is_same_v<T, AccelSample>) x.acc_mps2 = ma;
-          else if constexpr (std::is_same_v<T, GyroSample>) x.rate_radps = ma;
-          else if constexpr (std::is_same_v<T, MagSample>) x.field_ut = ma;
-          else if constexpr (std::is_same_v<T, UncalAccelSample>) x.acc_mps2 = ma, x.bias_mps2 = mb;
-          else if constexpr (std::is_same_v<T, UncalGyroSample>) x.rate_radps = ma, x.drift_radps = mb;
-          else if constexpr (std::is_same_v<T, UncalMagSample>) x.field_ut = ma, x.bias_ut = mb;
-        },
-        s);
+    if (const auto [a, bias] = motion_vectors(s); a) {
+      *a = b.sum_a / b.n;
+      if (bias) *bias = b.sum_b / b.n;
+    }
     out.push_back(std::move(s));
     b = Block{};
   };
-  for (const Sample& s : in) {
-    Eigen::Vector3d va, vb;
-    const bool vec = vectors(s, &va, &vb);
+  for (Sample s : in) {
+    const auto [pa, pb] = motion_vectors(s);
+    const bool vec = pa != nullptr;
+    const Eigen::Vector3d va = vec ? *pa : Eigen::Vector3d::Zero(), vb = pb ? *pb : Eigen::Vector3d::Zero();
     const bool decimated = std::holds_alternative<RotationVectorSample>(s) || std::holds_alternative<GameRotationVectorSample>(s) ||
                            std::holds_alternative<OrientationSample>(s);
     if (!vec && !decimated) {
-      out.push_back(s);
+      out.push_back(std::move(s));
       continue;
     }
     Block& b = blocks[s.index()];
@@ -604,14 +600,9 @@ std::vector<std::string> written_log_paths(const EvalPdrArgs& a) {
     for (int k = 2; used.count(name); ++k) name = base + "-" + std::to_string(k) + ".log";
     if (name != base + ".log") std::cerr << "eval-pdr: " << log << " is written as " << name << " (another input has its name)\n";
     used.insert(name);
-    const std::filesystem::path target = std::filesystem::path(a.write_logs_dir) / name;
-    std::error_code ec;
-    if (std::filesystem::exists(target, ec))
-      for (const std::string& input : a.logs)
-        if (std::filesystem::equivalent(target, input, ec))
-          throw std::invalid_argument("--write-logs: " + target.string() + " is the input " + input +
-                                      ": write the evaluated walks to another folder");
-    out.push_back(target.string());
+    const std::string target = (std::filesystem::path(a.write_logs_dir) / name).string();
+    refuse_writing_over_input(target, a.logs, "--write-logs: ", "write the evaluated walks to another folder");
+    out.push_back(target);
   }
   return out;
 }

@@ -1,4 +1,5 @@
 // `pdnav inspect LOG`: what a session log / GnssLogger log contains and what the reader skipped.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -56,14 +57,18 @@ class Progress {
   int last_ = -1;
 };
 
+/// Distinct timestamps per second over the type's span; NaN with fewer than two.
+double rate_hz(const TypeSummary& s) {
+  const double span_s = static_cast<double>(s.last_t - s.first_t) * 1e-9;
+  return s.distinct_t > 1 && span_s > 0 ? static_cast<double>(s.distinct_t - 1) / span_s : kNaN;
+}
+
 void print_types(const std::map<std::string, TypeSummary>& types) {
   std::printf("%-16s %9s %10s %16s %16s %10s %9s\n", "type", "count", "distinct_t", "first_t_s",
               "last_t_s", "span_s", "rate_hz");
   for (const auto& [name, s] : types) {
     const double span_s = static_cast<double>(s.last_t - s.first_t) * 1e-9;
-    const std::string rate = s.distinct_t > 1 && span_s > 0
-                                 ? fmt("%.3f", static_cast<double>(s.distinct_t - 1) / span_s)
-                                 : std::string("-");
+    const std::string rate = std::isfinite(rate_hz(s)) ? fmt("%.3f", rate_hz(s)) : std::string("-");
     std::printf("%-16s %9lld %10lld %16.6f %16.6f %10.3f %9s\n", name.c_str(),
                 static_cast<long long>(s.count), static_cast<long long>(s.distinct_t),
                 static_cast<double>(s.first_t) * 1e-9, static_cast<double>(s.last_t) * 1e-9, span_s,
@@ -121,9 +126,8 @@ void run_inspect(const InspectArgs& a) {
   print_types(types);
   for (const char* accel : {"Accel", "UncalAccel"}) {  // the step detector needs its rate
     const auto it = types.find(accel);
-    if (it == types.end() || it->second.distinct_t < 2 || it->second.last_t <= it->second.first_t) continue;
-    const double rate_hz = static_cast<double>(it->second.distinct_t - 1) / (static_cast<double>(it->second.last_t - it->second.first_t) * 1e-9);
-    if (rate_hz < pdr::Pdr::kMinAccelRateHz) std::printf("warning: %s\n", accel_rate_warning(rate_hz).c_str());
+    if (it != types.end() && rate_hz(it->second) < pdr::Pdr::kMinAccelRateHz)  // false for NaN
+      std::printf("warning: %s\n", accel_rate_warning(rate_hz(it->second)).c_str());
   }
   if (any)
     std::printf("time span: %.6f s .. %.6f s (%.3f s)\n", static_cast<double>(t_min) * 1e-9,

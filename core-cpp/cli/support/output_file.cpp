@@ -7,13 +7,18 @@
 
 namespace pdnav::cli {
 
+void refuse_writing_over_input(const std::string& path, const std::vector<std::string>& inputs,
+                               const std::string& option, const std::string& advice) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return;
+  for (const std::string& input : inputs)
+    if (std::filesystem::equivalent(path, input, ec))
+      throw std::invalid_argument(option + path + " is the input " + input + ": " + advice);
+}
+
 OutputFile::OutputFile(std::string path, const std::vector<std::string>& inputs)
     : path_(std::move(path)), partial_(path_ + ".partial") {
-  std::error_code ec;
-  if (std::filesystem::exists(path_, ec))
-    for (const std::string& input : inputs)
-      if (std::filesystem::equivalent(path_, input, ec))
-        throw std::invalid_argument(path_ + " is the input " + input + ": choose another output file");
+  refuse_writing_over_input(path_, inputs, "", "choose another output file");
 }
 
 OutputFile::~OutputFile() {

@@ -9,10 +9,14 @@
 
 namespace pdnav::cli {
 
+/// Throws std::invalid_argument "<option>PATH is the input INPUT: <advice>" when path names an
+/// existing file that is one of inputs (the same file under any name: std::filesystem::equivalent).
+void refuse_writing_over_input(const std::string& path, const std::vector<std::string>& inputs,
+                               const std::string& option, const std::string& advice);
+
 class OutputFile {
  public:
-  /// Throws std::invalid_argument when path names an existing file that is one of inputs
-  /// (the same file under any name: std::filesystem::equivalent).
+  /// refuse_writing_over_input first.
   OutputFile(std::string path, const std::vector<std::string>& inputs);
   OutputFile(const OutputFile&) = delete;
   OutputFile& operator=(const OutputFile&) = delete;

@@ -117,8 +117,7 @@ HeadingSource Pdr::heading_source(TimeNs t_ns) const {
   if (!fusion_.valid() || abs_weight_ns_ < 0) return HeadingSource::kInitial;
   // without a live gyroscope the heading follows the absolute stream whatever its weight
   // (HeadingFusionOptions::no_gyro_tau_s): that stream is the source, never "gyro"
-  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
-  if (!gyro_live) return abs_kind_;
+  if (!gyro_live(t_ns)) return abs_kind_;
   // the mean weight decays toward 0 while no reading arrives: the gyro alone carries it then
   const double age_s = std::max(0.0, ns_to_s(t_ns - abs_weight_ns_));
   const double w = abs_weight_mean_ * std::exp(-age_s / opt_.source_tau_s);
@@ -136,9 +135,7 @@ void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight, H
     abs_weight_mean_ = a * abs_weight_mean_ + (1.0 - a) * weight;
   }
   abs_weight_ns_ = t_ns;
-  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s &&
-                         tracker_.has_gravity();
-  fusion_.add(t_ns, heading_mag_rad, tracker_.axis_yaw_rad(), weight, gyro_live);
+  fusion_.add(t_ns, heading_mag_rad, tracker_.axis_yaw_rad(), weight, gyro_live(t_ns) && tracker_.has_gravity());
   have_heading_ = true;
   ref_t_ns_ = t_ns;
 }
@@ -179,7 +176,6 @@ void Pdr::feed(const AccelSample& s) {
   have_accel_ = true;
   if (first_accel_ns_ < 0) first_accel_ns_ = s.t_ns;
   last_accel_ns_ = std::max(last_accel_ns_, s.t_ns);
-  ++accel_fed_;
   last_cal_accel_ns_ = s.t_ns;
   latest_ns_ = std::max(latest_ns_, s.t_ns);  // "now" for the steps the waits below release
   tracker_.feed(s);
@@ -194,8 +190,7 @@ void Pdr::feed(const AccelSample& s) {
   settle_handling_wait(s.t_ns, false);
   settle_vehicle_wait(s.t_ns, false);
   // two steps between pauses count as a walk only while the handling gate can refuse jolts
-  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(s.t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
-  const bool gyro_gate = opt_.gate_handling && gyro_live;
+  const bool gyro_gate = opt_.gate_handling && gyro_live(s.t_ns);
   gate_.set_short_walk_min_steps(gyro_gate ? opt_.detector.short_walk_min_steps_gyro : opt_.detector.short_walk_min_steps);
   gate_.set_min_steps(gyro_gate && opt_.detector.bout_min_steps_gyro > 0 ? opt_.detector.bout_min_steps_gyro
                                                                          : opt_.detector.bout_min_steps);
@@ -531,8 +526,7 @@ void Pdr::feed(const MagSample& s) {
   if (!tracker_.has_gravity()) return;
   const auto compass =
       compass_heading_rad(field_ut, tracker_.up_phone(), reference_axis(), opt_.heading.min_horizontal);
-  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(s.t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
-  if (compass && gyro_live) {
+  if (compass && gyro_live(s.t_ns)) {
     qsf_.add(s.t_ns, *compass + tracker_.axis_yaw_rad(), field_ut.norm());
     ++counters_.mag_readings_qsf_tested;
     counters_.mag_readings_quasi_static += qsf_.quasi_static();
@@ -644,9 +638,15 @@ double Pdr::heading_rad() const {
   return wrap_two_pi(fusion_.heading_mag_rad(yaw, latest_ns_) + offset + declination_rad_);
 }
 
+bool Pdr::gyro_live(TimeNs t_ns) const {
+  return last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.heading.turn.gap_reset_s;
+}
+
 double Pdr::accel_rate_hz() const {
-  if (accel_fed_ < 2 || first_accel_ns_ < 0 || last_accel_ns_ <= first_accel_ns_) return kNaN;
-  return static_cast<double>(accel_fed_ - 1) / ns_to_s(last_accel_ns_ - first_accel_ns_);
+  // every sample through feed(AccelSample): calibrated, or bias-removed in place of it
+  const std::int64_t fed = sensors_.accel + sensors_.uncal_accel;
+  if (fed < 2 || first_accel_ns_ < 0 || last_accel_ns_ <= first_accel_ns_) return kNaN;
+  return static_cast<double>(fed - 1) / ns_to_s(last_accel_ns_ - first_accel_ns_);
 }
 
 double Pdr::heading_sigma_rad() const {

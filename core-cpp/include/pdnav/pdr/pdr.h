@@ -282,6 +282,8 @@ class Pdr {
   void trim_consistency(TimeNs t_ns);
   Eigen::Vector3d reference_axis() const;
   void absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight, HeadingSource kind);
+  /// A gyroscope sample arrived within the turn tracker's gap (heading.turn.gap_reset_s) of t_ns.
+  bool gyro_live(TimeNs t_ns) const;
   HeadingSource heading_source(TimeNs t_ns) const;
   void sync_placement();
   /// Without an accelerometer (a log of the fused sensors only): the reference axis from the
@@ -292,8 +294,7 @@ class Pdr {
   bool have_rv_up_ = false;
   Eigen::Vector3d rv_up_phone_ = Eigen::Vector3d::UnitZ();
   TimeNs last_cal_accel_ns_ = -1, last_cal_gyro_ns_ = -1, last_cal_mag_ns_ = -1;
-  TimeNs first_accel_ns_ = -1, last_accel_ns_ = -1;  // the accelerometer's rate (accel_rate_hz),
-  std::int64_t accel_fed_ = 0;                          // calibrated or bias-removed
+  TimeNs first_accel_ns_ = -1, last_accel_ns_ = -1;  // the accelerometer's rate (accel_rate_hz)
   TimeNs first_uncal_accel_ns_ = -1, first_uncal_gyro_ns_ = -1, first_uncal_mag_ns_ = -1;
   /// An uncalibrated sample is used once its stream has run uncal_fallback_s without its
   /// calibrated twin (never mixed with it: a log with both uses the calibrated one only).
