@@ -64,20 +64,59 @@ void PlacementEstimator::start_bout(TimeNs t_ns) {
 
 void PlacementEstimator::feed(const GyroSample& s) {
   if (!s.rate_radps.allFinite()) return;
+  real_gyro_ns_ = std::max(real_gyro_ns_, s.t_ns);
+  feed_rate(s.t_ns, s.rate_radps);
+}
+
+void PlacementEstimator::feed(const MagSample& s) {
+  const double n = s.field_ut.norm();
+  if (!(opt_.mag_rate_lowpass_hz > 0.0) || !s.field_ut.allFinite() || !(n > 1e-6)) return;
+  // a phone with a gyroscope: it gives the rate (its first sample may come a little after the field's)
+  if (real_gyro_ns_ >= 0) return;
+  if (first_mag_ns_ < 0) first_mag_ns_ = s.t_ns;
+  const double dt_norm = mag_norm_ns_ >= 0 ? ns_to_s(s.t_ns - mag_norm_ns_) : -1.0;
+  if (mag_norm_ns_ >= 0 && !(dt_norm > 0.0)) return;  // a duplicate or backwards sample
+  const double dt = mag_ns_ >= 0 ? ns_to_s(s.t_ns - mag_ns_) : -1.0;
+  // the steadiness of the field's magnitude
+  mag_norm_ns_ = s.t_ns;
+  if (dt_norm < 0.0 || dt_norm > 0.5) mag_norm_mean_ut_ = n;
+  else mag_norm_mean_ut_ += std::min(1.0, dt_norm / opt_.mag_steady_tau_s) * (n - mag_norm_mean_ut_);
+  const bool steady = std::abs(n / mag_norm_mean_ut_ - 1.0) <= opt_.mag_steady_tolerance;
+  if (!steady || ns_to_s(s.t_ns - first_mag_ns_) <= opt_.mag_rate_start_s) {
+    mag_ns_ = -1;  // the direction filter restarts with the next steady reading
+    return;
+  }
+  const Eigen::Vector3d m = s.field_ut / n;
+  mag_ns_ = s.t_ns;
+  if (dt < 0.0 || dt > 0.5) {  // first sample or after a gap: the filter restarts
+    mag_lp1_ = mag_lp2_ = m;
+    return;
+  }
+  const double a = 1.0 - std::exp(-2.0 * kPi * opt_.mag_rate_lowpass_hz * dt);
+  const Eigen::Vector3d before = mag_lp2_;
+  mag_lp1_ += a * (m - mag_lp1_);
+  mag_lp2_ += a * (mag_lp1_ - mag_lp2_);
+  const double n2 = before.squaredNorm() * mag_lp2_.squaredNorm();
+  if (!(n2 > 1e-12)) return;
+  // dm/dt = m x w: the rate square to the field is -(m x dm/dt) / |m|^2
+  feed_rate(s.t_ns, -before.cross(mag_lp2_) / (std::sqrt(n2) * dt));
+}
+
+void PlacementEstimator::feed_rate(TimeNs t_ns, const Eigen::Vector3d& rate_radps) {
   // the gait band of the angular rate (the same first-order high-pass as the acceleration's)
-  const double dt = w_hp_ns_ >= 0 ? ns_to_s(s.t_ns - w_hp_ns_) : -1.0;
+  const double dt = w_hp_ns_ >= 0 ? ns_to_s(t_ns - w_hp_ns_) : -1.0;
   if (dt > 0.0 && dt <= 0.5 && opt_.gait_highpass_hz > 0.0) {
     const double a = 1.0 / (1.0 + 2.0 * kPi * opt_.gait_highpass_hz * dt);
-    w_hp_out_ = a * (w_hp_out_ + s.rate_radps - w_hp_in_);
-    w_hp_in_ = s.rate_radps;
-    w_hp_ns_ = s.t_ns;
+    w_hp_out_ = a * (w_hp_out_ + rate_radps - w_hp_in_);
+    w_hp_in_ = rate_radps;
+    w_hp_ns_ = t_ns;
   } else if (w_hp_ns_ < 0 || dt > 0.5) {  // first sample or after a gap: the filter restarts
-    w_hp_in_ = s.rate_radps;
+    w_hp_in_ = rate_radps;
     w_hp_out_.setZero();
-    w_hp_ns_ = s.t_ns;
+    w_hp_ns_ = t_ns;
   }  // a duplicate or backwards sample leaves the filter as it is
-  gyro_radps_ = s.rate_radps;
-  gyro_ns_ = s.t_ns;
+  gyro_radps_ = rate_radps;
+  gyro_ns_ = t_ns;
 }
 
 void PlacementEstimator::feed(const AccelSample& s, bool walking) {

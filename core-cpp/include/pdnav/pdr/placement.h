@@ -100,6 +100,21 @@ struct PlacementOptions {
   // dominates: second / largest eigenvalue of sum w_h w_h^T below rotation_axis_max_ratio
   // (TYREX pockets and swinging 0.12-0.36, phone at the ear 0.57-0.80); 0 = off.
   double rotation_axis_max_ratio = 0.5;
+  // Without a gyroscope the rotation is read from the magnetometer: the Earth's field is fixed
+  // in the world, so its direction m in phone axes turns as dm/dt = m x w, and w minus its part
+  // along m is -(m x dm/dt) / |m|^2 (the "virtual gyroscope" of gyro-less phones; the rate
+  // about the field itself is not observable, at mid latitudes the field is 60-70 deg from the
+  // horizontal gait axes). The field's direction is low-passed by two first-order sections at
+  // this cut-off (the gait's rotation lives below it, the sensor noise above) and the rate
+  // stands in for the gyroscope in the tilt filter and the rotation axis; 0 = off.
+  double mag_rate_lowpass_hz = 4.0;
+  double mag_rate_start_s = 1.0;  // ... once the field has come this long without a gyroscope sample
+  // ... while the field's magnitude holds within this fraction of its mean over the last
+  // mag_steady_tau_s (first-order): near iron or a magnet the field turns as the phone moves
+  // through it, not only as it rotates, and its magnitude changes with it (the quasi-static
+  // field test of the compass, Afzal et al. 2011, applied to the rate)
+  double mag_steady_tolerance = 0.05;
+  double mag_steady_tau_s = 1.0;
 };
 
 /// A placement bout: from t_start_ns to t_end_ns (last sample so far for the open one).
@@ -123,6 +138,9 @@ class PlacementEstimator {
   /// Feeds one gyroscope sample (phone axes, rad/s): propagates the tilt between accelerometer
   /// samples. Without gyroscope samples the 2 s mean of the accelerometer is "up".
   void feed(const GyroSample& s);
+  /// Feeds one magnetometer sample (phone axes, uT, hard iron removed): on a phone without a
+  /// gyroscope its turning stands in for the angular rate (PlacementOptions::mag_rate_lowpass_hz).
+  void feed(const MagSample& s);
   /// Ends the current bout (e.g. the phone was handled); the next sample starts a new one.
   void end_bout();
   /// A step interval (s) from the step detector: the step band follows the walker's cadence
@@ -178,6 +196,8 @@ class PlacementEstimator {
   Eigen::Vector3d step_band(const Eigen::Vector3d& lin, double dt_s);
   // the walking direction from the dominant horizontal gait rotation axis (unsigned), if any
   std::optional<Eigen::Vector3d> rotation_axis_forward() const;
+  // one angular rate sample (phone axes, rad/s), from the gyroscope or the magnetometer
+  void feed_rate(TimeNs t_ns, const Eigen::Vector3d& rate_radps);
   double flip_threshold() const;
 
   PlacementOptions opt_;
@@ -231,6 +251,14 @@ class PlacementEstimator {
   Eigen::Vector3d gyro_radps_ = Eigen::Vector3d::Zero();
   TimeNs gyro_ns_ = -1;
   TimeNs tilt_ns_ = -1;
+  TimeNs real_gyro_ns_ = -1;  // the last gyroscope sample (the magnetometer's rate is not used then)
+  // the magnetometer's rate: the field's direction, low-passed (two first-order sections), and
+  // the mean of its magnitude (the steadiness test)
+  Eigen::Vector3d mag_lp1_ = Eigen::Vector3d::Zero(), mag_lp2_ = Eigen::Vector3d::Zero();
+  TimeNs mag_ns_ = -1;
+  TimeNs first_mag_ns_ = -1;
+  double mag_norm_mean_ut_ = 0.0;
+  TimeNs mag_norm_ns_ = -1;
 };
 
 }  // namespace pdnav::pdr
