@@ -515,7 +515,9 @@ void Pdr::feed(const MagSample& s) {
   latest_ns_ = std::max(latest_ns_, s.t_ns);
   magcal_.add(s.t_ns, s.field_ut);
   const Eigen::Vector3d field_ut = magcal_.corrected(s.field_ut);  // hard iron removed
-  placement_.feed(MagSample{s.t_ns, s.utc_ms, field_ut});  // without a gyroscope, its turning is the rate
+  // without a gyroscope, the field's turning is the rate of the placement and the stride test
+  if (const auto rate_radps = placement_.feed(MagSample{s.t_ns, s.utc_ms, field_ut}))
+    detector_.feed(GyroSample{s.t_ns, s.utc_ms, *rate_radps});
   const bool rv_fresh = have_rv_ && ns_to_s(s.t_ns - last_rv_ns_) <= opt_.heading.rv_max_age_s;
   if (opt_.magcal.restart_change_ut > 0.0 && !rv_fresh &&
       (magcal_.bias_ut() - compass_bias_ut_).norm() >= opt_.magcal.restart_change_ut) {

@@ -68,14 +68,14 @@ void PlacementEstimator::feed(const GyroSample& s) {
   feed_rate(s.t_ns, s.rate_radps);
 }
 
-void PlacementEstimator::feed(const MagSample& s) {
+std::optional<Eigen::Vector3d> PlacementEstimator::feed(const MagSample& s) {
   const double n = s.field_ut.norm();
-  if (!(opt_.mag_rate_lowpass_hz > 0.0) || !s.field_ut.allFinite() || !(n > 1e-6)) return;
+  if (!(opt_.mag_rate_lowpass_hz > 0.0) || !s.field_ut.allFinite() || !(n > 1e-6)) return std::nullopt;
   // a phone with a gyroscope: it gives the rate (its first sample may come a little after the field's)
-  if (real_gyro_ns_ >= 0) return;
+  if (real_gyro_ns_ >= 0) return std::nullopt;
   if (first_mag_ns_ < 0) first_mag_ns_ = s.t_ns;
   const double dt_norm = mag_norm_ns_ >= 0 ? ns_to_s(s.t_ns - mag_norm_ns_) : -1.0;
-  if (mag_norm_ns_ >= 0 && !(dt_norm > 0.0)) return;  // a duplicate or backwards sample
+  if (mag_norm_ns_ >= 0 && !(dt_norm > 0.0)) return std::nullopt;  // a duplicate or backwards sample
   const double dt = mag_ns_ >= 0 ? ns_to_s(s.t_ns - mag_ns_) : -1.0;
   // the steadiness of the field's magnitude
   mag_norm_ns_ = s.t_ns;
@@ -84,22 +84,24 @@ void PlacementEstimator::feed(const MagSample& s) {
   const bool steady = std::abs(n / mag_norm_mean_ut_ - 1.0) <= opt_.mag_steady_tolerance;
   if (!steady || ns_to_s(s.t_ns - first_mag_ns_) <= opt_.mag_rate_start_s) {
     mag_ns_ = -1;  // the direction filter restarts with the next steady reading
-    return;
+    return std::nullopt;
   }
   const Eigen::Vector3d m = s.field_ut / n;
   mag_ns_ = s.t_ns;
   if (dt < 0.0 || dt > 0.5) {  // first sample or after a gap: the filter restarts
     mag_lp1_ = mag_lp2_ = m;
-    return;
+    return std::nullopt;
   }
   const double a = 1.0 - std::exp(-2.0 * kPi * opt_.mag_rate_lowpass_hz * dt);
   const Eigen::Vector3d before = mag_lp2_;
   mag_lp1_ += a * (m - mag_lp1_);
   mag_lp2_ += a * (mag_lp1_ - mag_lp2_);
   const double n2 = before.squaredNorm() * mag_lp2_.squaredNorm();
-  if (!(n2 > 1e-12)) return;
+  if (!(n2 > 1e-12)) return std::nullopt;
   // dm/dt = m x w: the rate square to the field is -(m x dm/dt) / |m|^2
-  feed_rate(s.t_ns, -before.cross(mag_lp2_) / (std::sqrt(n2) * dt));
+  const Eigen::Vector3d rate_radps = -before.cross(mag_lp2_) / (std::sqrt(n2) * dt);
+  feed_rate(s.t_ns, rate_radps);
+  return rate_radps;
 }
 
 void PlacementEstimator::feed_rate(TimeNs t_ns, const Eigen::Vector3d& rate_radps) {

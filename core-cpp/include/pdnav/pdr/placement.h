@@ -140,7 +140,8 @@ class PlacementEstimator {
   void feed(const GyroSample& s);
   /// Feeds one magnetometer sample (phone axes, uT, hard iron removed): on a phone without a
   /// gyroscope its turning stands in for the angular rate (PlacementOptions::mag_rate_lowpass_hz).
-  void feed(const MagSample& s);
+  /// Returns the rate read from it (phone axes, rad/s, its part along the field missing), if any.
+  std::optional<Eigen::Vector3d> feed(const MagSample& s);
   /// Ends the current bout (e.g. the phone was handled); the next sample starts a new one.
   void end_bout();
   /// A step interval (s) from the step detector: the step band follows the walker's cadence

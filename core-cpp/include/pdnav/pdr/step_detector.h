@@ -105,6 +105,7 @@ struct StepDetectorOptions {
   // the accelerometer moves only 3-7 deg while the phone turns +-15-25 deg. Measured at the
   // stride-like candidates (amplitude at 1/I, p10-p90): swinging hand 1.3-2.3 rad/s, runs
   // 1.7-5.2; pockets, phone at the ear and hand-held (ILC) 0.5-1.0 rad/s. 0 = the tilt always.
+  // Without a gyroscope Pdr feeds the magnetometer's rate (PlacementOptions::mag_rate_lowpass_hz).
   double stride_min_rotation_radps = 1.0;
   // --- Input hygiene.
   double gap_reset_s = 0.5;            // a sample gap longer than this resets the detector
