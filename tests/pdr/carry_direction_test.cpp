@@ -78,22 +78,13 @@ void feed(Pdr& pdr, const Recording& r, bool with_gyro, TimeNs until_ns = std::n
   }
 }
 
-/// A whole TYREX recording (accelerometer and gyroscope) through a Pdr in auto mount, finished.
-std::unique_ptr<Pdr> replayed(const std::string& name, PdrOptions o = {}) {
+/// A whole TYREX recording (accelerometer and gyroscope; without_gyro: accelerometer and
+/// magnetometer, a phone without a gyroscope) through a Pdr in auto mount, finished.
+std::unique_ptr<Pdr> replayed(const std::string& name, PdrOptions o = {}, bool without_gyro = false) {
   o.heading.mount = Mount::kAuto;
   const Recording r = read_tyrex(name);
   auto pdr = std::make_unique<Pdr>(o);
-  feed(*pdr, r, true);
-  pdr->finish();
-  return pdr;
-}
-
-/// The same from the accelerometer and magnetometer alone (a phone without a gyroscope).
-std::unique_ptr<Pdr> replayed_without_gyro(const std::string& name, PdrOptions o = {}) {
-  o.heading.mount = Mount::kAuto;
-  const Recording r = read_tyrex(name);
-  auto pdr = std::make_unique<Pdr>(o);
-  feed(*pdr, r, false, std::numeric_limits<TimeNs>::max(), true);
+  feed(*pdr, r, !without_gyro, std::numeric_limits<TimeNs>::max(), without_gyro);
   pdr->finish();
   return pdr;
 }
@@ -328,8 +319,8 @@ TEST(PdrSteps, WithoutAGyroscopeTheSwingOfAStrideIsReadFromTheMagnetometer) {
     SCOPED_TRACE(w.name);
     PdrOptions off;
     off.placement.mag_rate_lowpass_hz = 0.0;
-    const auto with = replayed_without_gyro(w.name);
-    const auto without = replayed_without_gyro(w.name, off);
+    const auto with = replayed(w.name, {}, true);
+    const auto without = replayed(w.name, off, true);
     const std::int64_t added_with = with->counters().steps_added_at_stride_midpoints;
     const std::int64_t added_without = without->counters().steps_added_at_stride_midpoints;
     std::printf("%-36s accel + mag: %lld steps added at stride midpoints with the magnetometer's rate (%d of %d "

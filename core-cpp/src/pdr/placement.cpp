@@ -64,7 +64,7 @@ void PlacementEstimator::start_bout(TimeNs t_ns) {
 
 void PlacementEstimator::feed(const GyroSample& s) {
   if (!s.rate_radps.allFinite()) return;
-  real_gyro_ns_ = std::max(real_gyro_ns_, s.t_ns);
+  have_gyro_ = true;
   feed_rate(s.t_ns, s.rate_radps);
 }
 
@@ -72,24 +72,24 @@ std::optional<Eigen::Vector3d> PlacementEstimator::feed(const MagSample& s) {
   const double n = s.field_ut.norm();
   if (!(opt_.mag_rate_lowpass_hz > 0.0) || !s.field_ut.allFinite() || !(n > 1e-6)) return std::nullopt;
   // a phone with a gyroscope: it gives the rate (its first sample may come a little after the field's)
-  if (real_gyro_ns_ >= 0) return std::nullopt;
+  if (have_gyro_) return std::nullopt;
   if (first_mag_ns_ < 0) first_mag_ns_ = s.t_ns;
-  const double dt_norm = mag_norm_ns_ >= 0 ? ns_to_s(s.t_ns - mag_norm_ns_) : -1.0;
-  if (mag_norm_ns_ >= 0 && !(dt_norm > 0.0)) return std::nullopt;  // a duplicate or backwards sample
   const double dt = mag_ns_ >= 0 ? ns_to_s(s.t_ns - mag_ns_) : -1.0;
+  if (mag_ns_ >= 0 && !(dt > 0.0)) return std::nullopt;  // a duplicate or backwards sample
+  mag_ns_ = s.t_ns;
+  const bool gap = dt < 0.0 || dt > 0.5;  // first sample or after a gap: both filters restart
   // the steadiness of the field's magnitude
-  mag_norm_ns_ = s.t_ns;
-  if (dt_norm < 0.0 || dt_norm > 0.5) mag_norm_mean_ut_ = n;
-  else mag_norm_mean_ut_ += std::min(1.0, dt_norm / opt_.mag_steady_tau_s) * (n - mag_norm_mean_ut_);
+  if (gap) mag_norm_mean_ut_ = n;
+  else mag_norm_mean_ut_ += std::min(1.0, dt / opt_.mag_steady_tau_s) * (n - mag_norm_mean_ut_);
   const bool steady = std::abs(n / mag_norm_mean_ut_ - 1.0) <= opt_.mag_steady_tolerance;
   if (!steady || ns_to_s(s.t_ns - first_mag_ns_) <= opt_.mag_rate_start_s) {
-    mag_ns_ = -1;  // the direction filter restarts with the next steady reading
+    mag_lp_running_ = false;  // the direction filter restarts with the next steady reading
     return std::nullopt;
   }
   const Eigen::Vector3d m = s.field_ut / n;
-  mag_ns_ = s.t_ns;
-  if (dt < 0.0 || dt > 0.5) {  // first sample or after a gap: the filter restarts
+  if (gap || !mag_lp_running_) {
     mag_lp1_ = mag_lp2_ = m;
+    mag_lp_running_ = true;
     return std::nullopt;
   }
   const double a = 1.0 - std::exp(-2.0 * kPi * opt_.mag_rate_lowpass_hz * dt);

@@ -252,14 +252,13 @@ class PlacementEstimator {
   Eigen::Vector3d gyro_radps_ = Eigen::Vector3d::Zero();
   TimeNs gyro_ns_ = -1;
   TimeNs tilt_ns_ = -1;
-  TimeNs real_gyro_ns_ = -1;  // the last gyroscope sample (the magnetometer's rate is not used then)
+  bool have_gyro_ = false;  // a gyroscope sample has come (the magnetometer's rate is not used then)
   // the magnetometer's rate: the field's direction, low-passed (two first-order sections), and
   // the mean of its magnitude (the steadiness test)
   Eigen::Vector3d mag_lp1_ = Eigen::Vector3d::Zero(), mag_lp2_ = Eigen::Vector3d::Zero();
-  TimeNs mag_ns_ = -1;
-  TimeNs first_mag_ns_ = -1;
+  bool mag_lp_running_ = false;  // the direction filter holds the previous steady reading
+  TimeNs mag_ns_ = -1, first_mag_ns_ = -1;  // the last and first magnetometer samples
   double mag_norm_mean_ut_ = 0.0;
-  TimeNs mag_norm_ns_ = -1;
 };
 
 }  // namespace pdnav::pdr
