@@ -193,6 +193,9 @@ int run_replay(const ReplayArgs& a) {
     for (std::size_t i = 0; i < p["vehicle_spans"].size(); ++i)
       std::cout << (i ? ", " : "") << f1(p["vehicle_spans"][i]["start_s"].get<double>()) << "-"
                 << f1(p["vehicle_spans"][i]["end_s"].get<double>()) << " s";
+    double handled_s = 0.0;
+    for (const auto& h : p["handling_spans"]) handled_s += h["end_s"].get<double>() - h["start_s"].get<double>();
+    std::cout << "; handling spans: " << p["handling_spans"].size() << " (" << f1(handled_s) << " s)";
     std::cout << "; longest step delay " << f1(p["max_step_delay_s"].get<double>()) << " s\n";
     if (!p["accel_rate_warning"].get<std::string>().empty())
       std::cout << "warning:  " << p["accel_rate_warning"].get<std::string>() << "\n";

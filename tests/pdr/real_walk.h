@@ -21,6 +21,7 @@ struct RealWalk {
   std::vector<AccelSample> accel;
   std::vector<GyroSample> gyro;
   std::vector<RotationVectorSample> rotation;
+  std::vector<MagSample> mag;  // read, not fed by run() (run_without_gyro feeds it)
 };
 
 /// The sensor lines of one ILC walk (tab-separated "unix_ms TYPE x y z [acc]").
@@ -38,6 +39,7 @@ inline RealWalk read_ilc(const std::string& path) {
     const TimeNs t = ms * 1'000'000;
     if (type == "TYPE_ACCELEROMETER") w.accel.push_back({t, ms, {x, y, z}});
     else if (type == "TYPE_GYROSCOPE") w.gyro.push_back({t, ms, {x, y, z}});
+    else if (type == "TYPE_MAGNETIC_FIELD") w.mag.push_back({t, ms, {x, y, z}});
     else if (type == "TYPE_ROTATION_VECTOR")
       w.rotation.push_back({t, ms, {x, y, z, std::sqrt(std::max(0.0, 1 - x * x - y * y - z * z))}, kNaN});
   }
@@ -59,6 +61,25 @@ inline std::vector<PdrStep> run(const pdr::PdrOptions& o, const RealWalk& a, con
   feed(a);
   if (b) feed(*b);
   p.finish();  // a short last walk and any step still waiting are released
+  for (const auto& st : p.take_steps()) out.push_back(st);
+  return out;
+}
+
+/// As run(), a phone without a gyroscope: the accelerometer and the magnetometer in time order.
+inline std::vector<PdrStep> run_without_gyro(const pdr::PdrOptions& o, const RealWalk& a, const RealWalk* b = nullptr) {
+  pdr::Pdr p(o);
+  std::vector<PdrStep> out;
+  auto feed = [&](const RealWalk& w) {
+    std::size_t im = 0;
+    for (const auto& s : w.accel) {
+      while (im < w.mag.size() && w.mag[im].t_ns <= s.t_ns) p.feed(w.mag[im++]);
+      p.feed(s);
+      for (const auto& st : p.take_steps()) out.push_back(st);
+    }
+  };
+  feed(a);
+  if (b) feed(*b);
+  p.finish();
   for (const auto& st : p.take_steps()) out.push_back(st);
   return out;
 }

@@ -114,7 +114,8 @@ def main(argv):
     elif not summary["errors"]["drms_m"] < 100.0:
         failures.append(f"replay DRMS {summary['errors']['drms_m']} m")
     pdr = summary.get("pdr", {})
-    for key in ("steps", "distance_m", "placements", "steps_refused_handling", "steps_refused_vehicle", "vehicle_spans"):
+    for key in ("steps", "distance_m", "placements", "steps_refused_handling", "steps_refused_vehicle", "vehicle_spans",
+                "handling_spans"):
         if key not in pdr:
             failures.append(f"summary.json pdr has no '{key}'")
     if pdr.get("vehicle_spans"):

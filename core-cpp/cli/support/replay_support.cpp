@@ -355,6 +355,10 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
   for (const pdr::MotionSpan& v : pdr.vehicle_spans())
     rides.push_back({{"start_s", ns_to_s(v.t_start_ns - t0_ns)}, {"end_s", ns_to_s(v.t_end_ns - t0_ns)}});
   j["vehicle_spans"] = rides;
+  nlohmann::json handled = nlohmann::json::array();
+  for (const pdr::MotionSpan& v : pdr.handling_spans())
+    handled.push_back({{"start_s", ns_to_s(v.t_start_ns - t0_ns)}, {"end_s", ns_to_s(v.t_end_ns - t0_ns)}});
+  j["handling_spans"] = handled;
   j["vehicle_max_score_s"] = c.vehicle_max_score_s;
   j["vehicle_kinematic_max_mps2"] = c.vehicle_kinematic_max_mps2;
   j["magnetometer_readings_trusted"] = c.mag_readings_trusted;

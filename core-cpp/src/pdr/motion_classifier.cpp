@@ -68,6 +68,28 @@ void MotionClassifier::feed(const GyroSample& s) {
   update(s.t_ns);
 }
 
+void MotionClassifier::feed_field_rate(TimeNs t_ns, const Eigen::Vector3d& rate_radps) {
+  if (!(opt_.field_rate_fraction > 0.0) || !rate_radps.allFinite()) return;
+  if (last_field_rate_ns_ >= 0 && t_ns <= last_field_rate_ns_) return;
+  if (last_field_rate_ns_ >= 0 && ns_to_s(t_ns - last_field_rate_ns_) > opt_.gyro_timeout_s)
+    field_rate_sq_.clear(), field_rate_sum_sq_ = 0.0;  // a gap: the window restarts
+  last_field_rate_ns_ = t_ns;
+  // the strikes' coherence (running exit) reads it as it reads a gyroscope
+  vehicle_sample(t_ns, kNaN, &rate_radps);
+  field_rate_sq_.emplace_back(t_ns, rate_radps.squaredNorm());
+  field_rate_sum_sq_ += field_rate_sq_.back().second;
+  const TimeNs horizon = t_ns - s_to_ns(opt_.window_s);
+  while (!field_rate_sq_.empty() && field_rate_sq_.front().first <= horizon) {
+    field_rate_sum_sq_ -= field_rate_sq_.front().second;
+    field_rate_sq_.pop_front();
+  }
+  if (field_rate_sq_.size() % 512 == 0) {
+    field_rate_sum_sq_ = 0.0;
+    for (const auto& [t, q] : field_rate_sq_) field_rate_sum_sq_ += q;
+  }
+  update(t_ns);
+}
+
 void MotionClassifier::update(TimeNs t_ns) {
   const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.gyro_timeout_s &&
                          gyro_.size() >= 4;
@@ -76,6 +98,13 @@ void MotionClassifier::update(TimeNs t_ns) {
     return gyro_live && ((rate_rms_ > f * opt_.handling_rate_radps && spread_ > opt_.axis_spread_min) ||
                          rate_rms_ > f * opt_.extreme_rate_radps);
   };
+  // without a gyroscope, the rate square to the field (feed_field_rate): its RMS alone, and no
+  // suspicion (the runs reach suspect_fraction of the test: MotionClassifierOptions::field_rate_fraction)
+  const bool field_live = !gyro_live && last_field_rate_ns_ >= 0 &&
+                          ns_to_s(t_ns - last_field_rate_ns_) <= opt_.gyro_timeout_s && field_rate_sq_.size() >= 4;
+  const bool field_turns_like_handling =
+      field_live && std::sqrt(std::max(0.0, field_rate_sum_sq_ / static_cast<double>(field_rate_sq_.size()))) >
+                        opt_.extreme_rate_radps * opt_.field_rate_fraction;
   double sigma = 0.0;  // of |a| over the last window
   if (acc_.size() >= 4) {
     const double n = static_cast<double>(acc_.size());
@@ -88,9 +117,10 @@ void MotionClassifier::update(TimeNs t_ns) {
   const bool keeps_rhythm = opt_.vehicle && opt_.running_min_coherence > 0.0 &&
                             sigma >= opt_.running_min_sigma_mps2 && gait_coherence_ >= opt_.running_min_coherence;
   running_state_ = keeps_rhythm && (running_state_ || gait_corr_ >= opt_.gait_exit_min);
-  if (running_state_ && turns_like_handling(1.0)) running_last_ns_ = t_ns;
+  const bool handling_now = turns_like_handling(1.0) || field_turns_like_handling;
+  if (running_state_ && handling_now) running_last_ns_ = t_ns;
   const bool gait = running_state_ || ran_within_hold(t_ns);
-  handling_raw_ = !gait && turns_like_handling(1.0);
+  handling_raw_ = !gait && handling_now;
   suspect_ = !gait && turns_like_handling(opt_.suspect_fraction);
   // a session's first second (or after a gyro gap): no full window of evidence either way
   young_ = !gyro_.empty() && ns_to_s(gyro_.back().first - gyro_.front().first) < 0.8 * opt_.window_s;

@@ -516,8 +516,11 @@ void Pdr::feed(const MagSample& s) {
   magcal_.add(s.t_ns, s.field_ut);
   const Eigen::Vector3d field_ut = magcal_.corrected(s.field_ut);  // hard iron removed
   // without a gyroscope, the field's turning is the rate of the placement and the stride test
-  if (const auto rate_radps = placement_.feed(MagSample{s.t_ns, s.utc_ms, field_ut}))
+  if (const auto rate_radps = placement_.feed(MagSample{s.t_ns, s.utc_ms, field_ut})) {
     detector_.feed(GyroSample{s.t_ns, s.utc_ms, *rate_radps});
+    classifier_.feed_field_rate(s.t_ns, *rate_radps);  // the handling test: waving counts no steps
+    track_handling();
+  }
   const bool rv_fresh = have_rv_ && ns_to_s(s.t_ns - last_rv_ns_) <= opt_.heading.rv_max_age_s;
   if (opt_.magcal.restart_change_ut > 0.0 && !rv_fresh &&
       (magcal_.bias_ut() - compass_bias_ut_).norm() >= opt_.magcal.restart_change_ut) {

@@ -227,6 +227,10 @@ class Pdr {
   std::vector<MotionSpan> vehicle_spans() const {
     return {classifier_.vehicle_spans().begin(), classifier_.vehicle_spans().end()};
   }
+  /// Handling spans found by the motion classifier (the latest 256; the open one included).
+  std::vector<MotionSpan> handling_spans() const {
+    return {classifier_.handling_spans().begin(), classifier_.handling_spans().end()};
+  }
   MotionState motion_state() const { return classifier_.state(); }
   /// Online hard-iron calibration of the magnetometer feeding the compass (bias in use, active).
   const MagCalibration& mag_calibration() const { return magcal_; }
