@@ -501,13 +501,16 @@ std::vector<Sample> with_rate(const std::vector<Sample>& in, double rate_hz) {
 /// The walk as if the walker had first waved the phone for --wave seconds standing at the first
 /// waypoint (the "as recorded" sessions, which start with calibration waving): the first
 /// Truth line moves to the start of the waving, the synthesised samples (phonesim/handling.h)
-/// end 20 ms before the first sensor sample, in its attitude and field. walk_start_ns: the
-/// original first waypoint time.
+/// end 20 ms before the first sensor sample, in its attitude and field, with uncalibrated twins
+/// where the walk logs them (its first bias of each). walk_start_ns: the original first waypoint time.
 std::vector<Sample> with_waving(const std::vector<Sample>& in, const EvalPdrArgs& a, const std::string& path,
                                 TimeNs* walk_start_ns) {
   phonesim::WavingEnd end;
   std::optional<std::size_t> truth0, first_sensor;
   std::vector<Eigen::Vector3d> acc, rate;
+  // a phone that logs the uncalibrated streams logs them while waved too: their twins, with the
+  // walk's first bias of each
+  std::optional<Eigen::Vector3d> accel_bias, gyro_drift, mag_bias;
   std::int64_t utc_minus_ns_ms = kMissingInt;  // utc_ms - t_ns / 1e6 of the first accelerometer sample
   for (std::size_t i = 0; i < in.size(); ++i) {
     const Sample& s = in[i];
@@ -522,6 +525,12 @@ std::vector<Sample> with_waving(const std::vector<Sample>& in, const EvalPdrArgs
       if (!end.rotation_xyzw) end.rotation_xyzw = x->quat_xyzw;
     } else if (const auto* x = std::get_if<MagSample>(&s)) {
       if (!end.field_phone_ut) end.field_phone_ut = x->field_ut;
+    } else if (const auto* x = std::get_if<UncalAccelSample>(&s)) {
+      if (!accel_bias) accel_bias = x->bias_mps2;
+    } else if (const auto* x = std::get_if<UncalGyroSample>(&s)) {
+      if (!gyro_drift) gyro_drift = x->drift_radps;
+    } else if (const auto* x = std::get_if<UncalMagSample>(&s)) {
+      if (!mag_bias) mag_bias = x->bias_ut;
     }
   }
   if (!truth0 || !first_sensor) throw std::runtime_error(path + ": --wave needs a Truth line and accelerometer samples");
@@ -545,9 +554,16 @@ std::vector<Sample> with_waving(const std::vector<Sample>& in, const EvalPdrArgs
   start.t_ns = w.accel.empty() ? start.t_ns : std::min(start.t_ns, w.accel.front().t_ns);
   out.push_back(start);
   for (std::size_t k = 0; k < w.accel.size(); ++k) {  // per instant as the ILC logs: Accel, Mag, Gyro, RV
+    const TimeNs t = w.accel[k].t_ns;
     push_stamped(w.accel[k]);
-    if (k < w.mag.size()) push_stamped(w.mag[k]);
+    if (accel_bias) push_stamped(UncalAccelSample{t, kMissingInt, w.accel[k].acc_mps2 + *accel_bias, *accel_bias});
+    if (k < w.mag.size()) {
+      push_stamped(w.mag[k]);
+      if (mag_bias) push_stamped(UncalMagSample{w.mag[k].t_ns, kMissingInt, w.mag[k].field_ut + *mag_bias, *mag_bias});
+    }
     push_stamped(w.gyro[k]);
+    if (gyro_drift)
+      push_stamped(UncalGyroSample{w.gyro[k].t_ns, kMissingInt, w.gyro[k].rate_radps + *gyro_drift, *gyro_drift});
     if (k < w.rotation.size()) push_stamped(w.rotation[k]);
   }
   for (std::size_t i = *first_sensor; i < in.size(); ++i)
