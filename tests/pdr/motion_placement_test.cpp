@@ -279,6 +279,36 @@ TEST(PdrMotion, WalkingWithASwingingHandIsNotHandling) {
   EXPECT_TRUE(c.handling_spans().empty());
 }
 
+TEST(PdrMotion, WithoutAGyroscopeTheFieldsRateIsTestedOnItsRmsAndOnlyThen) {
+  // the rate square to the field (feed_field_rate): handling above 6 rad/s x sqrt(2/3) = 4.9 rad/s
+  // RMS whatever its axis; ignored while a gyroscope is live
+  const auto classify = [](double amplitude_radps, bool gyro) {
+    MotionClassifier c;
+    for (int i = 0; i < 300; ++i) {
+      const double t = i * 0.01;
+      const TimeNs ns = static_cast<TimeNs>(t * 1e9);
+      // one axis, the walk's own accelerometer: RMS = amplitude / sqrt(2)
+      const Eigen::Vector3d w(amplitude_radps * std::sin(2 * kPi * 1.0 * t), 0.0, 0.0);
+      if (gyro) c.feed(GyroSample{ns, kMissingInt, Eigen::Vector3d(0.0, 0.0, 0.1)});
+      c.feed_field_rate(ns, w);
+      c.feed(AccelSample{ns, kMissingInt, {0, 0, 9.8 + 2 * std::sin(2 * kPi * 1.8 * t)}});
+    }
+    return c.state();
+  };
+  EXPECT_EQ(classify(8.0, false), MotionState::kHandling);  // 5.7 rad/s RMS
+  EXPECT_EQ(classify(6.0, false), MotionState::kWalking);   // 4.2 rad/s RMS: the TYREX hand run reaches 4.7
+  EXPECT_EQ(classify(8.0, true), MotionState::kWalking);    // the gyroscope's 0.1 rad/s decides
+  MotionClassifierOptions off;
+  off.field_rate_fraction = 0.0;
+  MotionClassifier c(off);
+  for (int i = 0; i < 300; ++i) {
+    const TimeNs ns = static_cast<TimeNs>(i * 1e7);
+    c.feed_field_rate(ns, Eigen::Vector3d(8.0, 0.0, 0.0));
+    c.feed(AccelSample{ns, kMissingInt, {0, 0, 9.8 + 2 * std::sin(2 * kPi * 1.8 * i * 0.01)}});
+  }
+  EXPECT_NE(c.state(), MotionState::kHandling);
+}
+
 TEST(PdrPlacement, RealHandHeldWalkIsFlatWithTopAheadAndAReversedPhoneIsFound) {
   const RealWalk walk = read_ilc(pdnav::test::shared_data(kWalk));
   {
