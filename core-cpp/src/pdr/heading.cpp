@@ -71,7 +71,8 @@ std::optional<double> compass_heading_rad(const Eigen::Vector3d& field_phone, co
   return horizontal_heading(f.dot(east), f.dot(north), min_horizontal);
 }
 
-GyroTurnTracker::GyroTurnTracker(const TurnOptions& options) : opt_(options) {}
+GyroTurnTracker::GyroTurnTracker(const TurnOptions& options)
+    : opt_(options), acc_window_(options.window_s, Eigen::Vector3d::Zero()) {}
 
 void GyroTurnTracker::feed(const AccelSample& s) {
   const SampleCheck c = check_sample(s.t_ns, s.acc_mps2.allFinite(), acc_last_ns_, have_acc_last_,
@@ -79,7 +80,6 @@ void GyroTurnTracker::feed(const AccelSample& s) {
   if (c == SampleCheck::kNonFinite || c == SampleCheck::kDuplicate || c == SampleCheck::kBackwards) return;
   if (c == SampleCheck::kGap) {
     acc_window_.clear();
-    acc_sum_.setZero();
   }
   const double dt_acc = have_acc_last_ ? ns_to_s(s.t_ns - acc_last_ns_) : 0.0;
   const double a_norm = s.acc_mps2.norm();
@@ -93,18 +93,11 @@ void GyroTurnTracker::feed(const AccelSample& s) {
   }
   have_acc_last_ = true;
   acc_last_ns_ = s.t_ns;
-  acc_window_.emplace_back(s.t_ns, s.acc_mps2);
-  acc_sum_ += s.acc_mps2;
-  const TimeNs horizon = s.t_ns - s_to_ns(opt_.window_s);
-  while (!acc_window_.empty() && acc_window_.front().first <= horizon) {
-    acc_sum_ -= acc_window_.front().second;
-    acc_window_.pop_front();
-  }
-  const bool window_full = acc_window_.size() >= 2 &&
-                           ns_to_s(acc_window_.back().first - acc_window_.front().first) >= 0.8 * opt_.window_s;
+  acc_window_.push(s.t_ns, s.acc_mps2);
+  const bool window_full = acc_window_.size() >= 2 && acc_window_.covered_s() >= 0.8 * opt_.window_s;
   // APT: average the acceleration while walking straight to estimate gravity; hold it in turns.
   if (window_full && (state_ == State::kStraight || !have_gravity_)) {
-    const Eigen::Vector3d mean = acc_sum_ / static_cast<double>(acc_window_.size());
+    const Eigen::Vector3d mean = acc_window_.sum() / static_cast<double>(acc_window_.size());
     if (mean.norm() > 0.3 * kStandardGravity_mps2) {
       up_ = mean.normalized();
       have_gravity_ = true;

@@ -18,28 +18,21 @@ const char* to_string(MotionState m) {
   return "standing";
 }
 
-MotionClassifier::MotionClassifier(const MotionClassifierOptions& options) : opt_(options) {}
+MotionClassifier::MotionClassifier(const MotionClassifierOptions& options)
+    : opt_(options),
+      acc_(options.window_s),
+      gyro_(options.window_s, Eigen::Matrix3d::Zero()),
+      field_rate_sq_(options.window_s, 0.0),
+      kin_h_(options.kinematic_window_s, Eigen::Vector3d::Zero()) {}
 
 void MotionClassifier::feed(const AccelSample& s) {
   const double m = s.acc_mps2.norm();
   if (!std::isfinite(m) || (last_acc_ns_ >= 0 && s.t_ns <= last_acc_ns_)) return;
   last_acc_ns_ = s.t_ns;
-  acc_.emplace_back(s.t_ns, m);
-  acc_sum_ += m;
-  acc_sq_ += m * m;
+  acc_.push(s.t_ns, m);
   kinematic_accel(s);
   vehicle_sample(s.t_ns, m, nullptr);
-  const TimeNs horizon = s.t_ns - s_to_ns(opt_.window_s);
-  while (!acc_.empty() && acc_.front().first <= horizon) {
-    acc_sum_ -= acc_.front().second;
-    acc_sq_ -= acc_.front().second * acc_.front().second;
-    acc_.pop_front();
-  }
-  if (acc_.size() < 4) return;  // sums re-derived now and then below keep rounding bounded
-  if (acc_.size() % 512 == 0) {
-    acc_sum_ = acc_sq_ = 0.0;
-    for (const auto& [t, v] : acc_) acc_sum_ += v, acc_sq_ += v * v;
-  }
+  if (acc_.size() < 4) return;
   update(s.t_ns);
 }
 
@@ -48,19 +41,8 @@ void MotionClassifier::feed(const GyroSample& s) {
   kinematic_gyro(s);  // (reads the previous sample's time)
   last_gyro_ns_ = s.t_ns;
   vehicle_sample(s.t_ns, kNaN, &s.rate_radps);
-  gyro_.emplace_back(s.t_ns, s.rate_radps);
-  gyro_outer_ += s.rate_radps * s.rate_radps.transpose();
-  const TimeNs horizon = s.t_ns - s_to_ns(opt_.window_s);
-  while (!gyro_.empty() && gyro_.front().first <= horizon) {
-    gyro_outer_ -= gyro_.front().second * gyro_.front().second.transpose();
-    gyro_.pop_front();
-  }
-  if (gyro_.size() % 512 == 0) {
-    gyro_outer_.setZero();
-    for (const auto& [t, w] : gyro_) gyro_outer_ += w * w.transpose();
-  }
-  const double n = static_cast<double>(gyro_.size());
-  const Eigen::Matrix3d c = gyro_outer_ / n;
+  gyro_.push(s.t_ns, s.rate_radps * s.rate_radps.transpose());
+  const Eigen::Matrix3d c = gyro_.sum() / static_cast<double>(gyro_.size());
   rate_rms_ = std::sqrt(std::max(0.0, c.trace()));
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(c, Eigen::EigenvaluesOnly);
   const Eigen::Vector3d ev = es.eigenvalues();  // ascending
@@ -71,28 +53,16 @@ void MotionClassifier::feed(const GyroSample& s) {
 void MotionClassifier::feed_field_rate(TimeNs t_ns, const Eigen::Vector3d& rate_radps) {
   if (!(opt_.field_rate_fraction > 0.0) || !rate_radps.allFinite()) return;
   if (last_field_rate_ns_ >= 0 && t_ns <= last_field_rate_ns_) return;
-  if (last_field_rate_ns_ >= 0 && ns_to_s(t_ns - last_field_rate_ns_) > opt_.gyro_timeout_s)
-    field_rate_sq_.clear(), field_rate_sum_sq_ = 0.0;  // a gap: the window restarts
+  if (last_field_rate_ns_ >= 0 && !live(last_field_rate_ns_, t_ns)) field_rate_sq_.clear();  // a gap: the window restarts
   last_field_rate_ns_ = t_ns;
   // the strikes' coherence (running exit) reads it as it reads a gyroscope
   vehicle_sample(t_ns, kNaN, &rate_radps);
-  field_rate_sq_.emplace_back(t_ns, rate_radps.squaredNorm());
-  field_rate_sum_sq_ += field_rate_sq_.back().second;
-  const TimeNs horizon = t_ns - s_to_ns(opt_.window_s);
-  while (!field_rate_sq_.empty() && field_rate_sq_.front().first <= horizon) {
-    field_rate_sum_sq_ -= field_rate_sq_.front().second;
-    field_rate_sq_.pop_front();
-  }
-  if (field_rate_sq_.size() % 512 == 0) {
-    field_rate_sum_sq_ = 0.0;
-    for (const auto& [t, q] : field_rate_sq_) field_rate_sum_sq_ += q;
-  }
+  field_rate_sq_.push(t_ns, rate_radps.squaredNorm());
   update(t_ns);
 }
 
 void MotionClassifier::update(TimeNs t_ns) {
-  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.gyro_timeout_s &&
-                         gyro_.size() >= 4;
+  const bool gyro_live = live(last_gyro_ns_, t_ns) && gyro_.size() >= 4;
   // the handling tests with the rates scaled by f (1: handling, suspect_fraction: suspicion)
   const auto turns_like_handling = [&](double f) {
     return gyro_live && ((rate_rms_ > f * opt_.handling_rate_radps && spread_ > opt_.axis_spread_min) ||
@@ -100,17 +70,11 @@ void MotionClassifier::update(TimeNs t_ns) {
   };
   // without a gyroscope, the rate square to the field (feed_field_rate): its RMS alone, and no
   // suspicion (the runs reach suspect_fraction of the test: MotionClassifierOptions::field_rate_fraction)
-  const bool field_live = !gyro_live && last_field_rate_ns_ >= 0 &&
-                          ns_to_s(t_ns - last_field_rate_ns_) <= opt_.gyro_timeout_s && field_rate_sq_.size() >= 4;
+  const bool field_live = !gyro_live && live(last_field_rate_ns_, t_ns) && field_rate_sq_.size() >= 4;
   const bool field_turns_like_handling =
-      field_live && std::sqrt(std::max(0.0, field_rate_sum_sq_ / static_cast<double>(field_rate_sq_.size()))) >
+      field_live && std::sqrt(std::max(0.0, field_rate_sq_.sum() / static_cast<double>(field_rate_sq_.size()))) >
                         opt_.extreme_rate_radps * opt_.field_rate_fraction;
-  double sigma = 0.0;  // of |a| over the last window
-  if (acc_.size() >= 4) {
-    const double n = static_cast<double>(acc_.size());
-    const double mu = acc_sum_ / n;
-    sigma = std::sqrt(std::max(0.0, acc_sq_ / n - mu * mu));
-  }
+  const double sigma = acc_.size() >= 4 ? acc_.sigma() : 0.0;  // of |a| over the last window
   // running: turns like handling, but with periodic foot strikes and a rotation that keeps
   // their rhythm (MotionClassifierOptions::running_min_coherence): gait, not handling. The
   // strikes' periodicity enters a run; the rhythm keeps it, and the hold_s after it as for handling.
@@ -123,7 +87,7 @@ void MotionClassifier::update(TimeNs t_ns) {
   handling_raw_ = !gait && handling_now;
   suspect_ = !gait && turns_like_handling(opt_.suspect_fraction);
   // a session's first second (or after a gyro gap): no full window of evidence either way
-  young_ = !gyro_.empty() && ns_to_s(gyro_.back().first - gyro_.front().first) < 0.8 * opt_.window_s;
+  young_ = !gyro_.empty() && gyro_.covered_s() < 0.8 * opt_.window_s;
   if (handling_raw_) handling_last_ns_ = t_ns;
   const bool handling = handling_last_ns_ >= 0 && ns_to_s(t_ns - handling_last_ns_) <= opt_.hold_s;
   if (handling) {
@@ -252,7 +216,7 @@ void MotionClassifier::vehicle_evaluate(TimeNs t_ns) {
   gait_coherence_ += alpha * (coherence - gait_coherence_);
   double gyro_cnt = 0, gyro_sq = 0;
   for (const Bin& b : bins_) gyro_cnt += b.gyro_n, gyro_sq += b.gyro_sq;
-  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(t_ns - last_gyro_ns_) <= opt_.gyro_timeout_s && gyro_cnt >= 4;
+  const bool gyro_live = live(last_gyro_ns_, t_ns) && gyro_cnt >= 4;
   const double rate_rms = gyro_live ? std::sqrt(gyro_sq / gyro_cnt) : 0.0;
 
   if (vehicle_) {
@@ -271,8 +235,8 @@ void MotionClassifier::vehicle_evaluate(TimeNs t_ns) {
                         max_sigma <= opt_.vehicle_max_sigma_mps2 && rate_rms <= opt_.vehicle_max_rate_radps;
   // kinematic evidence: a sustained horizontal acceleration while the phone turns slowly
   if (opt_.kinematic_min_mps2 > 0.0 && gyro_live && rate_rms <= opt_.vehicle_max_rate_radps && !kin_h_.empty() &&
-      ns_to_s(kin_h_.back().first - kin_h_.front().first) >= 0.9 * opt_.kinematic_window_s) {
-    const double a_h = kin_sum_.norm() / static_cast<double>(kin_h_.size());
+      kin_h_.covered_s() >= 0.9 * opt_.kinematic_window_s) {
+    const double a_h = kin_h_.sum().norm() / static_cast<double>(kin_h_.size());
     kinematic_max_mps2_ = std::max(kinematic_max_mps2_, a_h);
     if (a_h >= opt_.kinematic_min_mps2) kinematic_last_ns_ = t_ns;
   }
@@ -315,28 +279,15 @@ void MotionClassifier::kinematic_accel(const AccelSample& s) {
   kin_acc_ns_ = s.t_ns;
   // first sample, a gap, or no live gyroscope (the phone's turns can not be followed): gravity
   // restarts from the specific force and the window with it
-  const bool gyro_live = last_gyro_ns_ >= 0 && ns_to_s(s.t_ns - last_gyro_ns_) <= opt_.gyro_timeout_s;
-  if (!kin_have_up_ || dt < 0.0 || dt > opt_.gyro_timeout_s || !gyro_live) {
+  if (!kin_have_up_ || dt < 0.0 || dt > opt_.gyro_timeout_s || !live(last_gyro_ns_, s.t_ns)) {
     kin_up_ = dir;
     kin_have_up_ = true;
     kin_h_.clear();
-    kin_sum_.setZero();
     return;
   }
   // pulled toward the specific force with tau (the complementary filter of the tilt; gyro-propagated)
   kin_up_ = (kin_up_ + std::min(1.0, dt / opt_.kinematic_tilt_tau_s) * (dir - kin_up_)).normalized();
-  const Eigen::Vector3d h = s.acc_mps2 - s.acc_mps2.dot(kin_up_) * kin_up_;
-  kin_h_.emplace_back(s.t_ns, h);
-  kin_sum_ += h;
-  const TimeNs horizon = s.t_ns - s_to_ns(opt_.kinematic_window_s);
-  while (!kin_h_.empty() && kin_h_.front().first <= horizon) {
-    kin_sum_ -= kin_h_.front().second;
-    kin_h_.pop_front();
-  }
-  if (kin_h_.size() % 1024 == 0) {
-    kin_sum_.setZero();
-    for (const auto& [t, v] : kin_h_) kin_sum_ += v;
-  }
+  kin_h_.push(s.t_ns, s.acc_mps2 - s.acc_mps2.dot(kin_up_) * kin_up_);
 }
 
 }  // namespace pdnav::pdr

@@ -19,7 +19,8 @@ const char* to_string(Placement p) {
   return "unknown";
 }
 
-PlacementEstimator::PlacementEstimator(const PlacementOptions& options) : opt_(options) {}
+PlacementEstimator::PlacementEstimator(const PlacementOptions& options)
+    : opt_(options), win_(options.gravity_window_s, Eigen::Vector3d::Zero()) {}
 
 void PlacementEstimator::end_bout() {
   if (in_bout_) closed_.push_back(bout_);
@@ -143,19 +144,13 @@ void PlacementEstimator::feed(const AccelSample& s, bool walking) {
   tilt_ns_ = s.t_ns;
   if (have_last_ && dt > 0.5) {  // a gap: statistics restart, the bout goes on
     win_.clear();
-    sum_.setZero();
     hist_.clear();
   }
   have_last_ = true;
   last_ns_ = s.t_ns;
-  win_.emplace_back(s.t_ns, s.acc_mps2);
-  sum_ += s.acc_mps2;
-  while (!win_.empty() && win_.front().first <= s.t_ns - s_to_ns(opt_.gravity_window_s)) {
-    sum_ -= win_.front().second;
-    win_.pop_front();
-  }
-  const Eigen::Vector3d mean = sum_ / static_cast<double>(win_.size());
-  if (win_.size() < 2 || ns_to_s(win_.back().first - win_.front().first) < 0.5 * opt_.gravity_window_s ||
+  win_.push(s.t_ns, s.acc_mps2);
+  const Eigen::Vector3d mean = win_.sum() / static_cast<double>(win_.size());
+  if (win_.size() < 2 || win_.covered_s() < 0.5 * opt_.gravity_window_s ||
       mean.norm() < 0.3 * kStandardGravity_mps2)
     return;
   up_ = mean.normalized();

@@ -79,15 +79,13 @@ StepDetectorOptions StepDetectorOptions::paper() {
   return o;
 }
 
-StepDetector::StepDetector(const StepDetectorOptions& options) : opt_(options) {}
+StepDetector::StepDetector(const StepDetectorOptions& options) : opt_(options), window_(options.window_s) {}
 
 void StepDetector::reset() {
   have_last_ = false;
   filter_init_ = false;
   lp1_ = lp2_ = 0.0;
   window_.clear();
-  sum_ = sum_sq_ = 0.0;
-  pushes_since_resum_ = 0;
   last_defined_ = Symbol::kUndefined;
   period_max_ = period_min_ = 0.0;
   have_step_ = false;
@@ -111,36 +109,8 @@ double StepDetector::filter(double magnitude, double dt_s) {
   return lp2_;
 }
 
-void StepDetector::push_window(TimeNs t_ns, double value) {
-  window_.push_back({t_ns, value});
-  sum_ += value;
-  sum_sq_ += value * value;
-  const TimeNs horizon = t_ns - s_to_ns(opt_.window_s);
-  while (!window_.empty() && window_.front().t_ns <= horizon) {
-    sum_ -= window_.front().value;
-    sum_sq_ -= window_.front().value * window_.front().value;
-    window_.pop_front();
-  }
-  constexpr std::int64_t kResumEvery = 4096;
-  if (++pushes_since_resum_ >= kResumEvery) {
-    pushes_since_resum_ = 0;
-    sum_ = sum_sq_ = 0.0;
-    for (const auto& w : window_) {
-      sum_ += w.value;
-      sum_sq_ += w.value * w.value;
-    }
-  }
-}
-
-double StepDetector::window_sigma() const {
-  const double n = static_cast<double>(window_.size());
-  if (n < 2.0) return 0.0;
-  const double mean = sum_ / n;
-  return std::sqrt(std::max(0.0, sum_sq_ / n - mean * mean));
-}
-
 bool StepDetector::gate_open() const {
-  const double sigma = window_sigma();
+  const double sigma = window_.sigma();
   return sigma > 0.0 && sigma >= opt_.min_sigma_mps2;
 }
 
@@ -155,10 +125,9 @@ double StepDetector::swing_between(TimeNs from_ns, TimeNs to_ns) const {
 }
 
 StepDetector::Symbol StepDetector::quantise(double value) const {
-  const double n = static_cast<double>(window_.size());
-  if (n < 2.0) return Symbol::kUndefined;
-  const double mean = sum_ / n;
-  const double sigma = window_sigma();
+  if (window_.size() < 2) return Symbol::kUndefined;
+  const double mean = window_.mean();
+  const double sigma = window_.sigma();
   if (sigma < opt_.min_sigma_mps2 || sigma <= 0.0) return Symbol::kUndefined;
   if (value > mean + opt_.k_sigma * sigma) return Symbol::kHigh;
   if (value < mean - opt_.k_sigma * sigma) return Symbol::kLow;
@@ -298,7 +267,7 @@ std::optional<double> StepDetector::accept(TimeNs t_ns, bool finite, double raw,
   have_last_ = true;
   last_t_ns_ = t_ns;
   const double value = filter(raw, *dt_s);
-  push_window(t_ns, value);
+  window_.push(t_ns, value);
   return value;
 }
 

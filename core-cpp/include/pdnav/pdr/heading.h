@@ -16,6 +16,7 @@
 #include "pdnav/geo/events.h"
 #include "pdnav/geo/samples.h"
 #include "pdnav/pdr/step_detector.h"
+#include "pdnav/pdr/time_window.h"
 
 namespace pdnav::pdr {
 
@@ -118,8 +119,7 @@ class GyroTurnTracker {
   TurnOptions opt_;
   SampleCounters gyro_counters_, accel_counters_;
   // gravity: running mean of the accelerometer over window_s
-  std::deque<std::pair<TimeNs, Eigen::Vector3d>> acc_window_;
-  Eigen::Vector3d acc_sum_ = Eigen::Vector3d::Zero();
+  TimeWindowSum<Eigen::Vector3d> acc_window_;
   bool have_acc_last_ = false;
   TimeNs acc_last_ns_ = 0;
   Eigen::Vector3d up_ = Eigen::Vector3d::UnitZ();

@@ -23,6 +23,7 @@
 
 #include "pdnav/geo/samples.h"
 #include "pdnav/geo/units.h"
+#include "pdnav/pdr/time_window.h"
 
 namespace pdnav::pdr {
 
@@ -204,15 +205,17 @@ class MotionClassifier {
   void kinematic_gyro(const GyroSample& s);
   bool kinematic_recent(TimeNs t_ns) const;
 
+  /// A stream whose last sample (last_ns) is within gyro_timeout_s of t_ns.
+  bool live(TimeNs last_ns, TimeNs t_ns) const {
+    return last_ns >= 0 && ns_to_s(t_ns - last_ns) <= opt_.gyro_timeout_s;
+  }
+
   MotionClassifierOptions opt_;
-  std::deque<std::pair<TimeNs, double>> acc_;  // |a|
-  double acc_sum_ = 0.0, acc_sq_ = 0.0;
-  std::deque<std::pair<TimeNs, Eigen::Vector3d>> gyro_;
-  Eigen::Matrix3d gyro_outer_ = Eigen::Matrix3d::Zero();
+  TimeWindowMoments acc_;                 // |a| over window_s
+  TimeWindowSum<Eigen::Matrix3d> gyro_;   // omega omega^T over window_s
   TimeNs last_gyro_ns_ = -1;
   TimeNs last_acc_ns_ = -1;
-  std::deque<std::pair<TimeNs, double>> field_rate_sq_;  // |rate square to the field|^2 over the window
-  double field_rate_sum_sq_ = 0.0;
+  TimeWindowSum<double> field_rate_sq_;  // |rate square to the field|^2 over window_s
   TimeNs last_field_rate_ns_ = -1;
   double rate_rms_ = 0.0, spread_ = 0.0;
   MotionState state_ = MotionState::kStanding;
@@ -243,8 +246,7 @@ class MotionClassifier {
   Eigen::Vector3d kin_up_ = Eigen::Vector3d::UnitZ();
   bool kin_have_up_ = false;
   TimeNs kin_acc_ns_ = -1;  // previous accelerometer sample the filter took (the gyro's: last_gyro_ns_)
-  std::deque<std::pair<TimeNs, Eigen::Vector3d>> kin_h_;
-  Eigen::Vector3d kin_sum_ = Eigen::Vector3d::Zero();
+  TimeWindowSum<Eigen::Vector3d> kin_h_;  // over kinematic_window_s
   TimeNs kinematic_last_ns_ = -1;
   double kinematic_max_mps2_ = 0.0;
   double vehicle_max_score_s_ = 0.0;

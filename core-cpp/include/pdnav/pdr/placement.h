@@ -39,6 +39,7 @@
 
 #include "pdnav/geo/samples.h"
 #include "pdnav/geo/units.h"
+#include "pdnav/pdr/time_window.h"
 
 namespace pdnav::pdr {
 
@@ -202,8 +203,7 @@ class PlacementEstimator {
   double flip_threshold() const;
 
   PlacementOptions opt_;
-  std::deque<std::pair<TimeNs, Eigen::Vector3d>> win_;
-  Eigen::Vector3d sum_ = Eigen::Vector3d::Zero();
+  TimeWindowSum<Eigen::Vector3d> win_;  // specific force over gravity_window_s
   Eigen::Vector3d up_ = Eigen::Vector3d::UnitZ();
   bool have_up_ = false;
   bool have_last_ = false;

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "pdnav/geo/samples.h"
+#include "pdnav/pdr/time_window.h"
 
 namespace pdnav::pdr {
 
@@ -245,10 +246,6 @@ class StepDetector {
   const StepDetectorOptions& options() const { return opt_; }
 
  private:
-  struct Windowed {
-    TimeNs t_ns;
-    double value;
-  };
   struct Tilted {
     TimeNs t_ns;
     double value;           // filtered |a|
@@ -256,9 +253,7 @@ class StepDetector {
   };
   enum class Symbol { kUndefined, kLow, kHigh };
   double filter(double magnitude, double dt_s);
-  void push_window(TimeNs t_ns, double value);
   Symbol quantise(double value) const;
-  double window_sigma() const;
   /// Input hygiene, gap reset, low-pass and window for one raw value; the filtered value, or
   /// nothing when the sample is skipped (counted). dt_s: the time since the previous sample.
   std::optional<double> accept(TimeNs t_ns, bool finite, double raw, double* dt_s);
@@ -278,9 +273,7 @@ class StepDetector {
   bool filter_init_ = false;
   double lp1_ = 0.0, lp2_ = 0.0;
   // running statistics
-  std::deque<Windowed> window_;
-  double sum_ = 0.0, sum_sq_ = 0.0;
-  std::int64_t pushes_since_resum_ = 0;  // the sums are recomputed now and then (rounding drift)
+  TimeWindowMoments window_;  // filtered |a| over window_s
   // symbol state machine
   Symbol last_defined_ = Symbol::kUndefined;
   double period_max_ = 0.0, period_min_ = 0.0;
