@@ -187,11 +187,14 @@ struct Navigator::Impl {
       auto dem = cfg.dem ? cfg.dem : std::make_shared<const terrain::Dem>(terrain::Dem::load(cfg.dem_path));
       terrain::TerrainOptions topt = terrain::TerrainOptions::preset(cfg.terrain_preset);
       topt.particles = std::max(1, cfg.particles);
-      // The step-length model's stated 1-sigma (APT height model: 10 %) is mostly a per-walk
-      // scale error (the user's stride vs 0.415 h): a preset with a scale state must cover it.
-      // (The paper's four-state presets keep their per-step sigma_l only.)
+      // A preset with a scale state draws each particle's walker scale from the step model's
+      // per-walk error for an unknown walker: the fused filter's own prior for it
+      // (FusionFilterOptions::initial_scale_sigma, 18 %: measured between and within the real
+      // data sets), not the model's per-step 10 %. (The paper's four-state presets keep their
+      // per-step sigma_l only.)
       if (topt.step_scale_sigma > 0.0)
-        topt.step_scale_sigma = std::max(topt.step_scale_sigma, pdr.options().length.sigma_fraction);
+        topt.step_scale_sigma = std::max({topt.step_scale_sigma, pdr.options().length.sigma_fraction,
+                                          c.fusion.filter.initial_scale_sigma});
       terrain = std::make_unique<terrain::TerrainEngine>(topt, dem, seed);
     }
     if ((cfg.graph || !cfg.graph_path.empty()) && wants(cfg.mode, EngineMode::kRoute)) {
