@@ -16,6 +16,7 @@
 #include "pdnav/fusion/navigator.h"
 #include "pdnav/io/sample_source.h"
 #include "pdnav/pdr/pdr.h"
+#include "pdnav/terrain/terrain_engine.h"
 #include "support/replay_support.h"
 #include "support/sources.h"
 
@@ -163,6 +164,11 @@ int run_replay(const ReplayArgs& a) {
   if (st.n > 0) summary["errors"] = st.to_json();
   summary["reference"] = rec.reference_kind();
   summary["fusion"] = fusion_summary(nav);
+  if (const terrain::TerrainOptions* to = nav.terrain_options())  // the terrain engine as configured
+    summary["terrain"] = {{"preset", a.preset},
+                          {"particles", to->particles},
+                          {"walker_scale_sigma", to->step_scale_sigma},
+                          {"walk_grade_sigma", to->stride_walk_grade_sigma}};
   summary["pdr"] = pdr_summary_json(twin, nav.output(0).steps, std::max<TimeNs>(0, t0_ns));
   const fusion::NavigatorOutput o = nav.output(0);  // the PDR declination: model and any warning (#19.2)
   summary["declination"] = {{"known", o.declination_known}, {"deg", rad_to_deg(o.declination.declination_rad)},

@@ -928,6 +928,10 @@ NavigatorOutput Navigator::output(std::size_t max_particles) const {
 
 std::vector<ModeChange> Navigator::mode_changes() const { return {impl_->changes.begin(), impl_->changes.end()}; }
 
+const terrain::TerrainOptions* Navigator::terrain_options() const {
+  return impl_->terrain ? &impl_->terrain->options() : nullptr;
+}
+
 std::vector<std::pair<std::string, std::int64_t>> Navigator::fusion_counts() const {
   return {impl_->counts.begin(), impl_->counts.end()};
 }

@@ -17,7 +17,7 @@
 #include "pdnav/pdr/heading.h"
 #include "pdnav/geo/wmm.h"
 
-namespace pdnav::terrain { class Dem; }
+namespace pdnav::terrain { class Dem; struct TerrainOptions; }
 namespace pdnav::route { class WalkGraph; }
 namespace pdnav::gnss { class EphemerisStore; }
 
@@ -212,6 +212,9 @@ class Navigator {
   std::vector<std::pair<std::string, std::int64_t>> ignored() const;
   /// Fused-estimate hand-overs with reasons (the last 1000), oldest first.
   std::vector<ModeChange> mode_changes() const;
+  /// The terrain engine's options as configured here (the preset, particles, and the walker-scale
+  /// prior shared with the fused filter); nullptr without a terrain engine.
+  const terrain::TerrainOptions* terrain_options() const;
   /// Fusion counters (GNSS rejected by the gate, forced corrections, re-anchors, ...).
   std::vector<std::pair<std::string, std::int64_t>> fusion_counts() const;
   /// Names of two of them: the route engine's step-scale samples used / refused by the gate.
