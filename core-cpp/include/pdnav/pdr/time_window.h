@@ -49,7 +49,6 @@ class TimeWindowSum {
   const T& sum() const { return sum_; }
   /// Time from the oldest kept sample to the newest (0 when fewer than two).
   double covered_s() const { return samples_.size() < 2 ? 0.0 : ns_to_s(samples_.back().first - samples_.front().first); }
-  const std::deque<std::pair<TimeNs, T>>& samples() const { return samples_; }
 
  private:
   TimeNs span_ns_;
@@ -74,7 +73,6 @@ class TimeWindowMoments {
     const double mu = w_.sum()[0] / n;
     return std::sqrt(std::max(0.0, w_.sum()[1] / n - mu * mu));
   }
-  const TimeWindowSum<Eigen::Vector2d>& window() const { return w_; }
 
  private:
   TimeWindowSum<Eigen::Vector2d> w_;
