@@ -41,7 +41,7 @@ set_tests_properties(io_inspect_sensorlogger_zip PROPERTIES LABELS "io;cli" FIXT
 add_test(NAME io_replay_sensorlogger_zip
          COMMAND pdnav replay "${CMAKE_CURRENT_BINARY_DIR}/ethz-walk.zip" --out "${CMAKE_CURRENT_BINARY_DIR}/replay-ethz-zip" --quiet)
 set_tests_properties(io_replay_sensorlogger_zip PROPERTIES LABELS "io;cli" FIXTURES_REQUIRED io_sl_zip
-  PASS_REGULAR_EXPRESSION "\\(sensorlogger\\)\nsamples:  178209 \\(skipped lines: 0\\).*\npdr: +865 steps, [0-9.]+ m \\(accel\\+gyro\\+mag, heading: magnetometer\\). refused: handling 0, vehicle 0. vehicle spans: none. .*reference: gps-fix")
+  PASS_REGULAR_EXPRESSION "\\(sensorlogger\\)\nsamples:  178209 \\(skipped lines: 0\\).*\npdr: +867 steps, [0-9.]+ m \\(accel\\+gyro\\+mag, heading: magnetometer\\). refused: handling 0, vehicle 0. vehicle spans: none. .*reference: gps-fix")
 add_test(NAME io_inspect_phyphox_fixture COMMAND pdnav inspect "${PROJECT_SOURCE_DIR}/tests/data/loggers/phyphox-walk")
 set_tests_properties(io_inspect_phyphox_fixture PROPERTIES LABELS "io;cli"
   PASS_REGULAR_EXPRESSION "\\(phyphox\\).*Accel +3000 .*Fix +30 .*Gyro +3000 .*Mag +1500 .*Pressure +150 .*samples: 7683 skipped: 0\n")

@@ -103,7 +103,7 @@ double StepDetector::filter(double magnitude, double dt_s) {
   }
   // Two cascaded first-order sections, time-aware so irregular sampling is handled.
   const double tau = 1.0 / (2.0 * kPi * opt_.lowpass_hz);
-  const double alpha = dt_s / (tau + dt_s);
+  const double alpha = 1.0 - std::exp(-dt_s / tau);  // exact for a held input: the cut-off does not move with the rate
   lp1_ += alpha * (magnitude - lp1_);
   lp2_ += alpha * (lp1_ - lp2_);
   return lp2_;
@@ -283,7 +283,7 @@ std::vector<StepCandidate> StepDetector::feed(const AccelSample& s) {
       lpv1_ = lpv2_ = s.acc_mps2;
     } else {
       const double tau = 1.0 / (2.0 * kPi * std::max(opt_.lowpass_hz, 1.0));
-      const double alpha = dt_s / (tau + dt_s);
+      const double alpha = 1.0 - std::exp(-dt_s / tau);  // exact for a held input: the cut-off does not move with the rate
       lpv1_ += alpha * (s.acc_mps2 - lpv1_);
       lpv2_ += alpha * (lpv1_ - lpv2_);
     }

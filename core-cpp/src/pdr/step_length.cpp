@@ -28,7 +28,7 @@ StepLengthModel StepLengthModel::weinberg(double k) {
 }
 
 StepLengthModel StepLengthModel::unknown_walker() {
-  StepLengthModel m = weinberg(0.44);
+  StepLengthModel m = weinberg(0.428);
   return m;
 }
 

@@ -31,9 +31,10 @@ struct StepLengthModel {
   static StepLengthModel apt_male(double height_m);
   static StepLengthModel apt_female(double height_m);
   static StepLengthModel weinberg(double k);
-  /// The default when the walker is unknown (no height): Weinberg with K = 0.44, the constant
-  /// that gives the surveyed path length on the hand-held ILC 2020 walks (site2: 0.438,
-  /// checked on site1: length ratio 1.01; docs/pdr.md). Adapts with the step's vertical swing.
+  /// The default when the walker is unknown (no height): Weinberg with K = 0.428, the constant
+  /// that gives the surveyed path length on the hand-held ILC 2020 walks (site2 median length
+  /// ratio 1.012, checked on site1; docs/pdr.md) with the step detector's swing (its low-pass,
+  /// StepDetectorOptions::lowpass_hz). Adapts with the step's vertical swing.
   static StepLengthModel unknown_walker();
 
   /// Length of one step; swing_mps2 is used by kWeinberg, step_frequency_hz (1 / the step's
