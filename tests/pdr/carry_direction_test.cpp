@@ -17,7 +17,6 @@
 #include <memory>
 #include <sstream>
 #include <string>
-#include <type_traits>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -385,20 +384,17 @@ TEST(PdrSteps, GentleStepsAreCountedFromTheForwardAcceleration) {
   EXPECT_LE(on, 1.1 * texting.capture_steps);
 }
 
-/// The recording as a phone sampling its motion sensors at a quarter of the rate would give it:
-/// each accelerometer and gyroscope stream averaged over blocks of four samples (the sensor's own
-/// low-pass before decimation), stamped with the block's last sample.
+/// The recording as a phone sampling its motion sensors at 1 / block of the rate would give it:
+/// the stream's reading (`value`) averaged over consecutive blocks (the sensor's own low-pass
+/// before decimation), each stamped with its last sample.
 template <typename S>
-std::vector<S> block_averaged(const std::vector<S>& in, std::size_t block) {
+std::vector<S> block_averaged(const std::vector<S>& in, Eigen::Vector3d S::*value, std::size_t block) {
   std::vector<S> out;
   for (std::size_t i = 0; i + block <= in.size(); i += block) {
     S s = in[i + block - 1];
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (std::size_t k = i; k < i + block; ++k) sum += [&]() -> Eigen::Vector3d {
-        if constexpr (std::is_same_v<S, AccelSample>) return in[k].acc_mps2; else return in[k].rate_radps;
-      }();
-    if constexpr (std::is_same_v<S, AccelSample>) s.acc_mps2 = sum / static_cast<double>(block);
-    else s.rate_radps = sum / static_cast<double>(block);
+    for (std::size_t k = i; k < i + block; ++k) sum += in[k].*value;
+    s.*value = sum / static_cast<double>(block);
     out.push_back(s);
   }
   return out;
@@ -417,8 +413,8 @@ TEST(PdrSteps, TheSameWalkCountsTheSameStepsAtAnyAccelerometerRate) {
     SCOPED_TRACE(w.name);
     const Recording r200 = read_tyrex(w.name);
     Recording r50;
-    r50.accel = block_averaged(r200.accel, 4);
-    r50.gyro = block_averaged(r200.gyro, 4);
+    r50.accel = block_averaged(r200.accel, &AccelSample::acc_mps2, 4);
+    r50.gyro = block_averaged(r200.gyro, &GyroSample::rate_radps, 4);
     PdrOptions o;
     o.heading.mount = Mount::kAuto;
     Pdr at200(o), at50(o);

@@ -7,6 +7,8 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include "lowpass.h"
+
 namespace pdnav::pdr {
 
 const char* to_string(Placement p) {
@@ -93,10 +95,8 @@ std::optional<Eigen::Vector3d> PlacementEstimator::feed(const MagSample& s) {
     mag_lp_running_ = true;
     return std::nullopt;
   }
-  const double a = 1.0 - std::exp(-2.0 * kPi * opt_.mag_rate_lowpass_hz * dt);
   const Eigen::Vector3d before = mag_lp2_;
-  mag_lp1_ += a * (m - mag_lp1_);
-  mag_lp2_ += a * (mag_lp1_ - mag_lp2_);
+  detail::lowpass2(mag_lp1_, mag_lp2_, m, detail::lowpass_gain(dt, opt_.mag_rate_lowpass_hz));
   const double n2 = before.squaredNorm() * mag_lp2_.squaredNorm();
   if (!(n2 > 1e-12)) return std::nullopt;
   // dm/dt = m x w: the rate square to the field is -(m x dm/dt) / |m|^2

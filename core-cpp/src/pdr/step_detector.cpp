@@ -5,6 +5,8 @@
 #include <cmath>
 #include <complex>
 
+#include "lowpass.h"
+
 namespace pdnav::pdr {
 
 namespace {
@@ -102,11 +104,7 @@ double StepDetector::filter(double magnitude, double dt_s) {
     return magnitude;
   }
   // Two cascaded first-order sections, time-aware so irregular sampling is handled.
-  const double tau = 1.0 / (2.0 * kPi * opt_.lowpass_hz);
-  const double alpha = 1.0 - std::exp(-dt_s / tau);  // exact for a held input: the cut-off does not move with the rate
-  lp1_ += alpha * (magnitude - lp1_);
-  lp2_ += alpha * (lp1_ - lp2_);
-  return lp2_;
+  return detail::lowpass2(lp1_, lp2_, magnitude, detail::lowpass_gain(dt_s, opt_.lowpass_hz));
 }
 
 bool StepDetector::gate_open() const {
@@ -282,10 +280,7 @@ std::vector<StepCandidate> StepDetector::feed(const AccelSample& s) {
     if (history_.empty()) {
       lpv1_ = lpv2_ = s.acc_mps2;
     } else {
-      const double tau = 1.0 / (2.0 * kPi * std::max(opt_.lowpass_hz, 1.0));
-      const double alpha = 1.0 - std::exp(-dt_s / tau);  // exact for a held input: the cut-off does not move with the rate
-      lpv1_ += alpha * (s.acc_mps2 - lpv1_);
-      lpv2_ += alpha * (lpv1_ - lpv2_);
+      detail::lowpass2(lpv1_, lpv2_, s.acc_mps2, detail::lowpass_gain(dt_s, std::max(opt_.lowpass_hz, 1.0)));
     }
     const double norm = lpv2_.norm();
     history_.push_back({s.t_ns, value, norm > 1e-6 ? Eigen::Vector3d(lpv2_ / norm) : Eigen::Vector3d::UnitZ()});
