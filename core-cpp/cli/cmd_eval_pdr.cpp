@@ -48,6 +48,7 @@
 #include "pdnav/io/sample_source.h"
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/phonesim/handling.h"
+#include "pdnav/phonesim/sample_rate.h"
 #include "support/output_file.h"
 #include "support/replay_support.h"
 
@@ -420,84 +421,6 @@ std::vector<Sample> rotated_phone(const std::vector<Sample>& in, const Eigen::An
   return out;
 }
 
-/// The walk as a phone sampling its motion sensors at no more than --rate Hz would have
-/// recorded it: each accelerometer, gyroscope and magnetometer stream (and their uncalibrated
-/// twins) averaged over consecutive blocks of 1 / rate s, each block stamped with its last
-/// sample's time (an output data rate with its anti-alias averaging, what a sensor hub
-/// delivers at a lower rate); the rotation vectors and orientation angles keep the last sample
-/// of each block; every other line as recorded. A stream already at or below the rate is kept.
-/// The vectors --rate averages in a motion-sensor sample: the reading and, for the uncalibrated
-/// streams, its bias / drift (nullptr for the calibrated ones); {nullptr, nullptr} for any other line.
-std::pair<Eigen::Vector3d*, Eigen::Vector3d*> motion_vectors(Sample& s) {
-  return std::visit(
-      [](auto& x) -> std::pair<Eigen::Vector3d*, Eigen::Vector3d*> {
-        using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, AccelSample>) return {&x.acc_mps2, nullptr};
-        else if constexpr (std::is_same_v<T, GyroSample>) return {&x.rate_radps, nullptr};
-        else if constexpr (std::is_same_v<T, MagSample>) return {&x.field_ut, nullptr};
-        else if constexpr (std::is_same_v<T, UncalAccelSample>) return {&x.acc_mps2, &x.bias_mps2};
-        else if constexpr (std::is_same_v<T, UncalGyroSample>) return {&x.rate_radps, &x.drift_radps};
-        else if constexpr (std::is_same_v<T, UncalMagSample>) return {&x.field_ut, &x.bias_ut};
-        else return {nullptr, nullptr};
-      },
-      s);
-}
-
-std::vector<Sample> with_rate(const std::vector<Sample>& in, double rate_hz) {
-  const TimeNs block_ns = static_cast<TimeNs>(std::llround(1e9 / rate_hz));
-  struct Block {
-    bool open = false;
-    TimeNs cell = 0;  // the block's cell on the grid
-    int n = 0;
-    Sample last;
-    Eigen::Vector3d sum_a = Eigen::Vector3d::Zero(), sum_b = Eigen::Vector3d::Zero();
-  };
-  std::array<Block, std::variant_size_v<Sample>> blocks;
-  constexpr TimeNs kNoGrid = std::numeric_limits<TimeNs>::min();
-  std::array<TimeNs, std::variant_size_v<Sample>> grid0_ns;
-  grid0_ns.fill(kNoGrid);
-  std::vector<Sample> out;
-  out.reserve(in.size());
-  const auto flush = [&](Block& b) {
-    if (!b.open) return;
-    Sample s = b.last;
-    if (const auto [a, bias] = motion_vectors(s); a) {
-      *a = b.sum_a / b.n;
-      if (bias) *bias = b.sum_b / b.n;
-    }
-    out.push_back(std::move(s));
-    b = Block{};
-  };
-  for (Sample s : in) {
-    const auto [pa, pb] = motion_vectors(s);
-    const bool vec = pa != nullptr;
-    const Eigen::Vector3d va = vec ? *pa : Eigen::Vector3d::Zero(), vb = pb ? *pb : Eigen::Vector3d::Zero();
-    const bool decimated = std::holds_alternative<RotationVectorSample>(s) || std::holds_alternative<GameRotationVectorSample>(s) ||
-                           std::holds_alternative<OrientationSample>(s);
-    if (!vec && !decimated) {
-      out.push_back(std::move(s));
-      continue;
-    }
-    Block& b = blocks[s.index()];
-    const TimeNs t = sample_time_ns(s);
-    // blocks on a fixed grid of 1 / rate from the stream's first sample: the output rate is the
-    // rate asked for whatever the input's (a block of 2 or 3 samples alternates at 50 -> 20 Hz)
-    if (grid0_ns[s.index()] == kNoGrid) grid0_ns[s.index()] = t;
-    const TimeNs cell = t >= grid0_ns[s.index()] ? (t - grid0_ns[s.index()]) / block_ns : -1;
-    if (b.open && (cell != b.cell || cell < 0)) flush(b);
-    if (!b.open) b.open = true, b.cell = cell;
-    if (vec && va.allFinite() && vb.allFinite()) {
-      b.sum_a += va, b.sum_b += vb, ++b.n, b.last = s;
-    } else if (!vec) {
-      b.n = 1, b.last = s;
-    }
-    if (b.n == 0) b = Block{};  // a non-finite reading alone: dropped (the block restarts)
-  }
-  for (Block& b : blocks) flush(b);
-  std::stable_sort(out.begin(), out.end(), [](const Sample& x, const Sample& y) { return sample_time_ns(x) < sample_time_ns(y); });
-  return out;
-}
-
 /// The walk as if the walker had first waved the phone for --wave seconds standing at the first
 /// waypoint (the "as recorded" sessions, which start with calibration waving): the first
 /// Truth line moves to the start of the waving, the synthesised samples (phonesim/handling.h)
@@ -640,7 +563,7 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a, const std::s
     }
   }
   TimeNs walk_start_ns = std::numeric_limits<TimeNs>::min();
-  if (a.rate_hz > 0.0) samples = with_rate(samples, a.rate_hz);
+  if (a.rate_hz > 0.0) samples = phonesim::at_sample_rate(samples, a.rate_hz);
   if (a.turn_deg != 0.0) samples = with_turn(samples, a.turn_deg);
   if (a.pitch_deg != 0.0) samples = with_pitch(samples, a.pitch_deg, path);
   if (a.wave_s > 0.0) samples = with_waving(samples, a, path, &walk_start_ns);

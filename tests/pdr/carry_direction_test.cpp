@@ -17,12 +17,14 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include "pdnav/pdr/pdr.h"
+#include "pdnav/phonesim/sample_rate.h"
 #include "test_data.h"
 
 using namespace pdnav;
@@ -384,18 +386,20 @@ TEST(PdrSteps, GentleStepsAreCountedFromTheForwardAcceleration) {
   EXPECT_LE(on, 1.1 * texting.capture_steps);
 }
 
-/// The recording as a phone sampling its motion sensors at 1 / block of the rate would give it:
-/// the stream's reading (`value`) averaged over consecutive blocks (the sensor's own low-pass
-/// before decimation), each stamped with its last sample.
-template <typename S>
-std::vector<S> block_averaged(const std::vector<S>& in, Eigen::Vector3d S::*value, std::size_t block) {
-  std::vector<S> out;
-  for (std::size_t i = 0; i + block <= in.size(); i += block) {
-    S s = in[i + block - 1];
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (std::size_t k = i; k < i + block; ++k) sum += in[k].*value;
-    s.*value = sum / static_cast<double>(block);
-    out.push_back(s);
+/// The recording as a phone sampling its motion sensors at rate_hz would give it: what
+/// `pdnav eval-pdr --rate` replays (phonesim::at_sample_rate, the sensor's own block average
+/// before decimation).
+Recording at_rate(const Recording& r, double rate_hz) {
+  std::vector<Sample> all;
+  all.reserve(r.accel.size() + r.gyro.size() + r.mag.size());
+  for (const AccelSample& a : r.accel) all.emplace_back(a);
+  for (const GyroSample& g : r.gyro) all.emplace_back(g);
+  for (const MagSample& m : r.mag) all.emplace_back(m);
+  Recording out;
+  for (const Sample& s : phonesim::at_sample_rate(all, rate_hz)) {
+    if (const auto* a = std::get_if<AccelSample>(&s)) out.accel.push_back(*a);
+    else if (const auto* g = std::get_if<GyroSample>(&s)) out.gyro.push_back(*g);
+    else if (const auto* m = std::get_if<MagSample>(&s)) out.mag.push_back(*m);
   }
   return out;
 }
@@ -405,16 +409,15 @@ TEST(PdrSteps, TheSameWalkCountsTheSameStepsAtAnyAccelerometerRate) {
   // alpha = dt / (tau + dt), put the cut-off of a nominal 3 Hz at 2.86 Hz at 200 Hz and 2.55 Hz
   // at 50 Hz, and the gentle steps of a slow walk hang on it: these recordings at 200 Hz and
   // block-averaged to 50 Hz (what a phone at SENSOR_DELAY_GAME, Sensor Logger's default, gives)
-  // counted 74 / 62, 80 / 72 and 102 / 86 steps (accelerometer and gyroscope, this cut-off).
-  // Now alpha = 1 - exp(-dt / tau): 80 / 79, 85 / 84, 105 / 105.
+  // counted 74 / 62, 80 / 72 and 102 / 86 steps (accelerometer and gyroscope, this cut-off; 50 Hz
+  // as averages of every 4 samples). Now alpha = 1 - exp(-dt / tau): 80 / 83, 85 / 83, 105 / 103
+  // (50 Hz on eval-pdr --rate's time grid, phonesim::at_sample_rate).
   for (const CapturedWalk& w : {CapturedWalk{"Guillaume_Nexus5_NoDist_Phoning", 6.86, 121.36, 102},
                                 CapturedWalk{"Guillaume_Nexus5_NoDist_Texting", 7.46, 121.96, 109},
                                 CapturedWalk{"Guillaume_Nexus5_Dist_Texting", 7.09, 121.59, 103}}) {
     SCOPED_TRACE(w.name);
     const Recording r200 = read_tyrex(w.name);
-    Recording r50;
-    r50.accel = block_averaged(r200.accel, &AccelSample::acc_mps2, 4);
-    r50.gyro = block_averaged(r200.gyro, &GyroSample::rate_radps, 4);
+    const Recording r50 = at_rate(r200, 50.0);
     PdrOptions o;
     o.heading.mount = Mount::kAuto;
     Pdr at200(o), at50(o);
