@@ -83,7 +83,8 @@ struct MagCalibrationOptions {
   double max_bias_ut = 200.0;      // a fit beyond this is refused (phone hard iron: tens of uT)
   // Pdr: a bias that moved this far from the one the compass heading offset was learned with
   // restarts that offset (e.g. 3 uT: up to 9 deg across a 20 uT horizontal field); 0 = off.
-  // Off by default: on the ETH walk it cost outage_ratio 1.060 -> 1.103 (docs/pdr.md).
+  // Off by default: at 3 uT with the gyro-aided fit the ETH walk's DR gains (48.0 -> 46.0 m) but
+  // TYREX with compass headings loses (imu 1.62 -> 1.72 m, at 50 Hz 1.85 -> 2.13; docs/results.md).
   double restart_change_ut = 0.0;
 };
 
