@@ -2,10 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
+
+#include "reason_text.h"
 
 namespace pdnav::fusion {
 
@@ -18,13 +19,7 @@ double normal_quantile(double p) {
   return p < 0.5 ? -z : z;
 }
 
-std::string fmt(double v, int prec = 1) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(prec);
-  s << v;
-  return s.str();
-}
+using detail::fmt;
 }  // namespace
 
 double chi2_quantile(int dof, double p) {

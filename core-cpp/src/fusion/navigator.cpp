@@ -4,7 +4,6 @@
 #include <cmath>
 #include <deque>
 #include <map>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
 
@@ -17,6 +16,7 @@
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/route/route_engine.h"
 #include "pdnav/terrain/terrain_engine.h"
+#include "reason_text.h"
 
 namespace pdnav::fusion {
 
@@ -78,13 +78,7 @@ constexpr double kFusedRefreshS = 0.5;  // shown estimate refreshed at least thi
 constexpr std::size_t kModeChangesInOutput = 32;
 constexpr std::size_t kStepEstimatesKept = 256;  // per-step estimates held for take_step_estimates()
 
-std::string fmt(double v, int prec = 1) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(prec);
-  s << v;
-  return s.str();
-}
+using detail::fmt;
 
 TimeNs ns(double s) { return static_cast<TimeNs>(s * 1e9); }
 
