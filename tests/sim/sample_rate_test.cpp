@@ -81,7 +81,7 @@ TEST(SampleRate, OtherStreamsAreKeptOrDecimatedAndNonFiniteReadingsLeftOut) {
   EXPECT_EQ(only<PressureSample>(out).size(), 8u);  // as recorded
 }
 
-TEST(SampleRate, AStreamAtOrBelowTheRateKeepsEverySample) {
+TEST(SampleRate, AStreamBelowTheRateKeepsEverySample) {
   std::vector<Sample> in;
   for (int k = 0; k < 20; ++k) {
     GyroSample g;
