@@ -32,7 +32,10 @@ struct LoopRun {
 // Rectangle of 60 s legs (longer than the fusion's 60 s offset memory, so a heading-dependent
 // compass error shows on each leg), two loops; `disturbance_ut` adds a field that changes along the
 // walk (steel, magnets) in the world frame.
-LoopRun walk_rectangle(bool calibrate, double disturbance_ut, double restart_change_ut = 0.0) {
+// uncal_without_bias: gyro and magnetometer as uncalibrated readings whose bias estimate the logger
+// did not export (NaN: Sensor Logger's GyroscopeUncalibrated / MagnetometerUncalibrated.csv).
+LoopRun walk_rectangle(bool calibrate, double disturbance_ut, double restart_change_ut = 0.0,
+                       bool uncal_without_bias = false) {
   WalkSpec spec;
   spec.mount_yaw_deg = -90.0;  // phone +Y along the walking direction
   spec.final_straight_s = 60.0;
@@ -49,7 +52,11 @@ LoopRun walk_rectangle(bool calibrate, double disturbance_ut, double restart_cha
   LoopRun run;
   const double t0_s = ns_to_s(walk.accel.front().t_ns);
   for (std::size_t i = 0; i < walk.accel.size(); ++i) {
-    engine.feed(walk.gyro[i]);
+    const Eigen::Vector3d not_exported = Eigen::Vector3d::Constant(kNaN);
+    if (uncal_without_bias)
+      engine.feed(UncalGyroSample{walk.gyro[i].t_ns, walk.gyro[i].utc_ms, walk.gyro[i].rate_radps, not_exported});
+    else
+      engine.feed(walk.gyro[i]);
     engine.feed(walk.accel[i]);
     if (i % 2 == 0) {  // 50 Hz magnetometer
       const Eigen::Vector4d& q = walk.rotation[i].quat_xyzw;
@@ -59,7 +66,10 @@ LoopRun walk_rectangle(bool calibrate, double disturbance_ut, double restart_cha
           disturbance_ut * Eigen::Vector3d(std::sin(0.9 * t_s), std::cos(0.7 * t_s), 0.5 * std::sin(1.3 * t_s));
       Eigen::Vector3d m = phone_to_enu.conjugate() * (kFieldEnu + disturbance) + kBiasPhone;
       for (int k = 0; k < 3; ++k) m[k] += noise(rng);
-      engine.feed(MagSample{walk.accel[i].t_ns, kMissingInt, m});
+      if (uncal_without_bias)
+        engine.feed(UncalMagSample{walk.accel[i].t_ns, kMissingInt, m, not_exported});
+      else
+        engine.feed(MagSample{walk.accel[i].t_ns, kMissingInt, m});
     }
     for (const auto& s : engine.take_steps()) {
       const double t_s = ns_to_s(s.t_ns) - t0_s;
@@ -117,6 +127,19 @@ TEST(MagCalibration, FlatLoopWithHardIronBias) {
   EXPECT_LT((dflt.bias_ut - cal.bias_ut).norm(), 1e-9);
   EXPECT_LT(mean_abs(dflt.errors_deg), 0.6 * mean_abs(raw.errors_deg));
   EXPECT_GT(mean_abs(raw.errors_deg), 8.0);
+}
+
+TEST(MagCalibration, UncalibratedReadingsWithoutTheirBiasAreUsedRaw) {
+  // A logger that exports an uncalibrated stream's values but not the platform's bias estimate
+  // (the shared ETH Sensor Logger walk) must still give a compass heading: the readings are used
+  // raw and the hard-iron calibration removes the bias (before: NaN readings, no heading at all).
+  const LoopRun unc = walk_rectangle(true, 0.0, 3.0, true);
+  const LoopRun cal = walk_rectangle(true, 0.0, 3.0);
+  ASSERT_EQ(unc.errors_deg.size(), cal.errors_deg.size());
+  EXPECT_TRUE(unc.active);
+  EXPECT_NEAR(unc.bias_ut.x(), kBiasPhone.x(), 1.0);
+  EXPECT_NEAR(unc.bias_ut.y(), kBiasPhone.y(), 1.0);
+  EXPECT_LT(max_abs(unc.errors_deg), 6.0);
 }
 
 TEST(MagCalibration, DisturbedFieldIsRefused) {

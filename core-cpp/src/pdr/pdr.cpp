@@ -149,19 +149,30 @@ void Pdr::track_handling() {
   handling_reset_ = handled;
 }
 
+namespace {
+/// The platform's bias estimate of an uncalibrated reading, 0 where it is not given (NaN: a
+/// logger that exports values[0..2] only, e.g. Sensor Logger's *Uncalibrated.csv): such a
+/// reading is used raw, and the hard-iron calibration (mag_calibration.h) and the gyro-aided
+/// pairs' drift estimate take the bias out as they would from any raw stream.
+Eigen::Vector3d stated_bias(const Eigen::Vector3d& b) {
+  return Eigen::Vector3d(std::isfinite(b.x()) ? b.x() : 0.0, std::isfinite(b.y()) ? b.y() : 0.0,
+                         std::isfinite(b.z()) ? b.z() : 0.0);
+}
+}  // namespace
+
 void Pdr::feed(const UncalAccelSample& s) {
-  feed_uncal(AccelSample{s.t_ns, s.utc_ms, s.acc_mps2 - s.bias_mps2}, sensors_.uncal_accel, sensors_.accel,
-             last_cal_accel_ns_, first_uncal_accel_ns_);
+  feed_uncal(AccelSample{s.t_ns, s.utc_ms, s.acc_mps2 - stated_bias(s.bias_mps2)}, sensors_.uncal_accel,
+             sensors_.accel, last_cal_accel_ns_, first_uncal_accel_ns_);
 }
 
 void Pdr::feed(const UncalGyroSample& s) {
-  feed_uncal(GyroSample{s.t_ns, s.utc_ms, s.rate_radps - s.drift_radps}, sensors_.uncal_gyro, sensors_.gyro,
-             last_cal_gyro_ns_, first_uncal_gyro_ns_);
+  feed_uncal(GyroSample{s.t_ns, s.utc_ms, s.rate_radps - stated_bias(s.drift_radps)}, sensors_.uncal_gyro,
+             sensors_.gyro, last_cal_gyro_ns_, first_uncal_gyro_ns_);
 }
 
 void Pdr::feed(const UncalMagSample& s) {
-  feed_uncal(MagSample{s.t_ns, s.utc_ms, s.field_ut - s.bias_ut}, sensors_.uncal_mag, sensors_.mag, last_cal_mag_ns_,
-             first_uncal_mag_ns_);
+  feed_uncal(MagSample{s.t_ns, s.utc_ms, s.field_ut - stated_bias(s.bias_ut)}, sensors_.uncal_mag, sensors_.mag,
+             last_cal_mag_ns_, first_uncal_mag_ns_);
 }
 
 void Pdr::feed(const AccelSample& s) {

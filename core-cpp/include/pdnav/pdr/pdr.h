@@ -136,8 +136,9 @@ struct PdrCounters {
 };
 
 /// The sensors the PDR has been fed so far (issue 27, "every sensor set"): each stream counts
-/// when it was used. An uncalibrated stream (UncalAccel/UncalGyro/UncalMag, bias removed) is
-/// used only while its calibrated twin is absent (PdrOptions::uncal_fallback_s).
+/// when it was used. An uncalibrated stream (UncalAccel/UncalGyro/UncalMag, the stated bias
+/// removed; a bias the logger did not export is taken as 0) is used only while its calibrated
+/// twin is absent (PdrOptions::uncal_fallback_s).
 struct PdrSensorSet {
   std::int64_t accel = 0, gyro = 0, mag = 0, rotation_vector = 0, step_detector = 0;
   std::int64_t uncal_accel = 0, uncal_gyro = 0, uncal_mag = 0;  // used in place of the calibrated ones
