@@ -86,8 +86,11 @@ TEST(PdrSensorSet, UncalibratedStreamsStandInAndAreIgnoredBesideCalibrated) {
   spec.seed = 3;
   const test::SyntheticWalk w = test::make_walk(spec, {{10, 90}, {8, -45}});
   const Eigen::Vector3d drift(0.02, -0.015, 0.03);  // rad/s: a gyro offset the OS estimated
+  PdrOptions opt;
+  opt.heading.mount = Mount::kHandheld;  // the synthetic phone lies flat, top ahead (the default
+                                         // chest mount's -Z is vertical: no heading to compare)
   const auto run = [&](bool calibrated, bool uncal) {
-    Pdr pdr;
+    Pdr pdr(opt);
     std::vector<PdrStep> out;
     for (std::size_t i = 0; i < w.accel.size(); ++i) {
       pdr.feed(w.accel[i]);
@@ -117,6 +120,9 @@ TEST(PdrSensorSet, UncalibratedStreamsStandInAndAreIgnoredBesideCalibrated) {
       }
   }
   EXPECT_GT(compared, 20);
+  double spread = 0.0;  // the walk turned: the headings compared are not one constant
+  for (const PdrStep& c : cal) spread = std::max(spread, std::abs(wrap_pi(c.heading_rad - cal.front().heading_rad)));
+  EXPECT_GT(spread, 40.0 * kDegToRad);
   // beside the calibrated stream it is ignored: identical output
   ASSERT_EQ(both.size(), cal.size());
   for (std::size_t i = 0; i < cal.size(); ++i) EXPECT_EQ(both[i].heading_rad, cal[i].heading_rad);

@@ -376,6 +376,11 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
                           {"bias_sigma_ut", std::isfinite(cal.bias_sigma_ut()) ? nlohmann::json(cal.bias_sigma_ut()) : nlohmann::json()},
                           {"fits_accepted", cal.fits_accepted()},
                           {"fits_refused", cal.refusals()}};
+  if (pdr.gyro_bias_at_rest_used()) {  // an uncalibrated gyro without its drift (gyro_bias.h)
+    const Eigen::Vector3d b = pdr.gyro_bias_at_rest().bias_radps();
+    j["gyro_bias_at_rest"] = {{"still_blocks", pdr.gyro_bias_at_rest().still_blocks()},
+                              {"bias_dps", {rad_to_deg(b.x()), rad_to_deg(b.y()), rad_to_deg(b.z())}}};
+  }
   nlohmann::json bouts = nlohmann::json::array();
   for (const pdr::PlacementBout& b : pdr.placements()) {
     bouts.push_back({{"placement", pdr::to_string(b.placement)},

@@ -22,6 +22,7 @@ StepDetectorOptions forward_options(StepDetectorOptions o) {
 
 Pdr::Pdr(const PdrOptions& options)
     : opt_(options),
+      gyro_rest_(options.gyro_bias),
       detector_(options.detector),
       forward_detector_(forward_options(options.detector)),
       gate_(options.detector.bout_min_steps, options.detector.max_step_interval_s,
@@ -161,13 +162,21 @@ Eigen::Vector3d stated_bias(const Eigen::Vector3d& b) {
 }  // namespace
 
 void Pdr::feed(const UncalAccelSample& s) {
+  gyro_rest_.feed_accel(s.t_ns, s.acc_mps2);
   feed_uncal(AccelSample{s.t_ns, s.utc_ms, s.acc_mps2 - stated_bias(s.bias_mps2)}, sensors_.uncal_accel,
              sensors_.accel, last_cal_accel_ns_, first_uncal_accel_ns_);
 }
 
 void Pdr::feed(const UncalGyroSample& s) {
-  feed_uncal(GyroSample{s.t_ns, s.utc_ms, s.rate_radps - stated_bias(s.drift_radps)}, sensors_.uncal_gyro,
-             sensors_.gyro, last_cal_gyro_ns_, first_uncal_gyro_ns_);
+  Eigen::Vector3d drift = stated_bias(s.drift_radps);
+  if (!s.drift_radps.allFinite() && uncal_allowed(s.t_ns, last_cal_gyro_ns_, first_uncal_gyro_ns_)) {
+    // the logger did not export the platform's drift: ours, learned while the phone lies still
+    gyro_rest_used_ = true;
+    gyro_rest_.feed_gyro(s.t_ns, s.rate_radps);
+    drift = gyro_rest_.bias_radps();
+  }
+  feed_uncal(GyroSample{s.t_ns, s.utc_ms, s.rate_radps - drift}, sensors_.uncal_gyro, sensors_.gyro,
+             last_cal_gyro_ns_, first_uncal_gyro_ns_);
 }
 
 void Pdr::feed(const UncalMagSample& s) {
@@ -177,6 +186,7 @@ void Pdr::feed(const UncalMagSample& s) {
 
 void Pdr::feed(const AccelSample& s) {
   ++sensors_.accel;
+  gyro_rest_.feed_accel(s.t_ns, s.acc_mps2);
   // the first accelerometer sample after rotation-vector headings about the RV's own axis: the
   // placement's axis takes over, the offset learned about the other one must not mix in
   if (!have_accel_ && have_rv_up_ && opt_.heading.mount == Mount::kAuto &&

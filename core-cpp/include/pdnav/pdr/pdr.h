@@ -14,6 +14,7 @@
 #include "pdnav/geo/wmm.h"
 #include "pdnav/pdr/heading.h"
 #include "pdnav/pdr/heading_fusion.h"
+#include "pdnav/pdr/gyro_bias.h"
 #include "pdnav/pdr/mag_calibration.h"
 #include "pdnav/pdr/motion_classifier.h"
 #include "pdnav/pdr/placement.h"
@@ -52,6 +53,7 @@ struct PdrOptions {
   HeadingOptions heading;        // mount; APT Sec. V-B gyro re-orientation; fallbacks
   HeadingFusionOptions fusion;   // gyro-dominant heading, magnetic readings gated against WMM
   MagCalibrationOptions magcal;  // online hard-iron sphere fit (Vasconcelos et al. 2011)
+  GyroBiasOptions gyro_bias;     // an uncalibrated gyro without its drift: bias at rest (ZARU)
   PlacementOptions placement;    // placement + walking direction when heading.mount == kAuto
   MotionClassifierOptions motion;  // walking / standing / handling
   bool gate_handling = true;     // no steps while the phone is handled or waved
@@ -235,6 +237,10 @@ class Pdr {
   MotionState motion_state() const { return classifier_.state(); }
   /// Online hard-iron calibration of the magnetometer feeding the compass (bias in use, active).
   const MagCalibration& mag_calibration() const { return magcal_; }
+  /// The bias of an uncalibrated gyro stream that came without the platform's drift estimate,
+  /// learned while the phone lay still (gyro_bias.h); used() is false when no such stream came.
+  const GyroBiasAtRest& gyro_bias_at_rest() const { return gyro_rest_; }
+  bool gyro_bias_at_rest_used() const { return gyro_rest_used_; }
   /// The heading source of the emitted steps, as spans of consecutive steps.
   const std::vector<HeadingSourceSpan>& heading_sources() const { return source_spans_; }
   /// Sum of the emitted step lengths (m).
@@ -322,6 +328,8 @@ class Pdr {
   }
 
   PdrOptions opt_;
+  GyroBiasAtRest gyro_rest_;
+  bool gyro_rest_used_ = false;
   StepDetector detector_;
   StepDetector forward_detector_;  // forward_steps: the forward acceleration channel
   TimeNs last_candidate_ns_ = -1;  // the latest step candidate of either channel
