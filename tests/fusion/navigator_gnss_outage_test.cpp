@@ -189,15 +189,18 @@ namespace {
 
 struct ThinnedRun {
   int epochs = 0, gnss_mode_epochs = 0, degraded_epochs = 0;
+  std::int64_t mode_changes = 0;
+  double shortest_degraded_s = 1e9;  // shortest stay in "gnss-degraded" before "gnss"
   double mean_err_m = 0.0;
   TimeNs max_lag_ns = 0;  // shown time behind the last Raw row fed, at each Raw epoch's completion
 };
 
 /// The Mountain View log thinned: every `keep_every`-th Raw epoch (duty cycling), and at most
 /// `max_sats` GPS rows per epoch (a degraded sky); Fix rows dropped (Raw only).
-ThinnedRun thinned(int keep_every, int max_sats) {
+ThinnedRun thinned(int keep_every, int max_sats, double degraded_hold_s = FusionOptions{}.degraded_hold_s) {
   const std::vector<Sample> log = read_log();
   NavigatorConfig cfg;
+  cfg.fusion.degraded_hold_s = degraded_hold_s;
   cfg.nav_paths.push_back(test::shared_data("gnss-mountainview/hour2350.16n"));
   Navigator nav(cfg, 3);
   const geo::LocalFrame truth(kSurveyed);
@@ -228,6 +231,13 @@ ThinnedRun thinned(int keep_every, int max_sats) {
     sum += truth.to_enu(e.position).p_m.head<2>().norm();
   }
   r.mean_err_m = r.epochs ? sum / r.epochs : kNaN;
+  r.mode_changes = nav.output(0).mode_change_count;
+  TimeNs entered = -1;
+  for (const ModeChange& c : nav.mode_changes()) {
+    if (c.to == FusionMode::kGnssDegraded) entered = c.t_ns;
+    if (c.from == FusionMode::kGnssDegraded && c.to == FusionMode::kGnss && entered >= 0)
+      r.shortest_degraded_s = std::min(r.shortest_degraded_s, ns_to_s(c.t_ns - entered));
+  }
   if (r.epochs == 0)
     for (const Estimate& e : nav.output(0).engines) std::printf("  engine %s: %s\n", to_string(e.engine), e.reason.c_str());
   return r;
@@ -250,6 +260,21 @@ TEST(NavigatorDutyCycledGnss, FewerThanSixUsedSatellitesStillFeedTheFilterAsDegr
   ASSERT_GE(r.epochs, 50);
   EXPECT_GE(r.degraded_epochs, r.epochs / 2);
   EXPECT_LT(r.mean_err_m, 30.0);
+}
+
+TEST(NavigatorDutyCycledGnss, ASatelliteCountAtTheThresholdDoesNotFlipTheShownMode) {
+  // 8 GPS rows: the used count crosses min_sats_ok (6) now and then. The label holds
+  // "gnss-degraded" for degraded_hold_s after the last degraded epoch; without the hold it
+  // follows each epoch's count (the demo's simulated session: 45 -> 11 mode changes).
+  const ThinnedRun held = thinned(1, 8);
+  const ThinnedRun flipping = thinned(1, 8, 0.0);
+  std::printf("mode changes: %lld with the %.0f s hold (shortest degraded stay %.0f s), %lld without (%.0f s)\n",
+              static_cast<long long>(held.mode_changes), FusionOptions{}.degraded_hold_s, held.shortest_degraded_s,
+              static_cast<long long>(flipping.mode_changes), flipping.shortest_degraded_s);
+  EXPECT_LT(held.mode_changes, flipping.mode_changes);
+  EXPECT_LT(flipping.shortest_degraded_s, FusionOptions{}.degraded_hold_s);
+  EXPECT_GE(held.shortest_degraded_s, FusionOptions{}.degraded_hold_s);
+  EXPECT_NEAR(held.mean_err_m, flipping.mean_err_m, 0.5);  // the label only: the estimate is the same
 }
 
 }  // namespace

@@ -157,7 +157,8 @@ struct Navigator::Impl {
   TimeNs last_gnss_ns = -1;               // last accepted GNSS (Raw or Fix) position
   TimeNs last_raw_pos_ns = -1;            // last Raw epoch with an SPP position (accepted or not)
   IntervalAverage gnss_interval;          // between accepted GNSS positions
-  bool gnss_degraded = false;             // the last accepted one was degraded / Fix-only
+  bool gnss_degraded = false;             // a degraded / Fix-only one was accepted within degraded_hold_s
+  TimeNs last_degraded_gnss_ns = -1;
   std::string gnss_what;                  // description of the last accepted GNSS measurement
   std::string last_event;                 // the last notable filter event (for the reason)
   TimeNs last_raw_row_ns = -1;            // t of the last Raw row fed (pending epoch)
@@ -504,7 +505,8 @@ struct Navigator::Impl {
   void accepted_gnss(TimeNs t, const Eigen::Vector2d& z, double sigma_m, bool degraded, const std::string& what) {
     if (last_gnss_ns >= 0) gnss_interval.add(static_cast<double>(t - last_gnss_ns) * 1e-9);
     last_gnss_ns = t;
-    gnss_degraded = degraded;
+    if (degraded) last_degraded_gnss_ns = t;
+    gnss_degraded = last_degraded_gnss_ns >= 0 && t - last_degraded_gnss_ns <= ns(fo().degraded_hold_s);
     gnss_what = what;
     cal.add_gnss(t, z, sigma_m);
     const PdrCalibration& p = cal.published();

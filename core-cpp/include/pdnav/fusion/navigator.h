@@ -39,6 +39,11 @@ struct FusionOptions {
   double default_hdop = 2.0;          // when an epoch reports none
   int min_sats_ok = 6;                // fewer used satellites: degraded (sigma scaled below)
   double degraded_sigma_scale = 1.5;
+  /// The shown mode stays "gnss-degraded" until no degraded epoch was accepted for this long
+  /// (hysteresis of the label only; each epoch's own weight is its own): a satellite count
+  /// hovering at the threshold flipped it every 1-3 s (the demo's simulated session: 42 of its
+  /// 45 mode changes).
+  double degraded_hold_s = 10.0;
   double tdcp_sigma_m = 0.10;         // per axis, TDCP displacement (cm-level + phase-centre motion)
   double doppler_sigma_mps = 0.30;    // per axis, Doppler-derived velocity
   /// While the fused filter is locked to GNSS and the GNSS engine's own KF (SPP smoothed by
