@@ -60,9 +60,16 @@ void FusionFilter::advance_to(TimeNs t_ns) {
   const TimeNs quiet_from = last_step_ns_ + static_cast<TimeNs>(opt_.undetected_after_s * 1e9);
   const TimeNs a = std::max(t_ns_, quiet_from);
   if (t_ns > a) {
-    const double dt = static_cast<double>(t_ns - a) * 1e-9;
-    p_(0, 0) += opt_.undetected_motion_q_m2ps * dt;
-    p_(1, 1) += opt_.undetected_motion_q_m2ps * dt;
+    // (a, t_ns]: while motion sensors ran, steps were observed and none came (standing,
+    // shuffling); beyond blind_after_s after the last of their samples the motion is unobserved
+    const TimeNs blind_start = !track_sensing_ ? t_ns
+                               : last_sensing_ns_ < 0 ? a
+                                                      : last_sensing_ns_ + static_cast<TimeNs>(opt_.blind_after_s * 1e9);
+    const TimeNs b = std::clamp(blind_start, a, t_ns);
+    const double q = opt_.undetected_motion_q_m2ps * static_cast<double>(b - a) * 1e-9 +
+                     opt_.blind_motion_q_m2ps * static_cast<double>(t_ns - b) * 1e-9;
+    p_(0, 0) += q;
+    p_(1, 1) += q;
   }
   const double dt_all = static_cast<double>(t_ns - t_ns_) * 1e-9;
   // first-order Gauss-Markov residual states: decay towards 0, variance towards the stationary one

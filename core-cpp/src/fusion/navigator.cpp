@@ -178,6 +178,7 @@ struct Navigator::Impl {
   Impl(const NavigatorConfig& c, std::uint64_t s)
       : cfg(c), seed(s), pdr(pdr_options(c)), fused(c.mode == EngineMode::kAuto), ff(c.fusion.filter),
         cal(c.fusion.calibration) {
+    ff.track_motion_sensing(true);  // every motion-sensor sample is reported (feed): a GNSS-only log is blind
     if ((cfg.dem || !cfg.dem_path.empty()) && wants(cfg.mode, EngineMode::kTerrain)) {
       auto dem = cfg.dem ? cfg.dem : std::make_shared<const terrain::Dem>(terrain::Dem::load(cfg.dem_path));
       terrain::TerrainOptions topt = terrain::TerrainOptions::preset(cfg.terrain_preset);
@@ -397,6 +398,7 @@ struct Navigator::Impl {
                         std::is_same_v<T, SensorAccuracySample> || std::is_same_v<T, UncalAccelSample> ||
                         std::is_same_v<T, UncalGyroSample> || std::is_same_v<T, UncalMagSample>) {
             pdr.feed(x);
+            ff.note_motion_sensing(x.t_ns);
             drain_pdr();
           } else if constexpr (std::is_same_v<T, PressureSample>) {
             maybe_start(x.t_ns);
