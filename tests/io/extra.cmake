@@ -53,6 +53,11 @@ set_tests_properties(io_replay_not_a_log PROPERTIES LABELS "io;cli" WILL_FAIL TR
 add_test(NAME io_replay_not_a_log_message COMMAND pdnav replay /etc/passwd --out "${CMAKE_CURRENT_BINARY_DIR}/replay-not-a-log")
 set_tests_properties(io_replay_not_a_log_message PROPERTIES LABELS "io;cli"
   PASS_REGULAR_EXPRESSION "not a recording pdnav reads: expected .*. found first line")
+# a RINEX file given to replay says which command reads it (the shared GSDC observation file)
+add_test(NAME io_replay_rinex_obs_message
+         COMMAND pdnav replay "${PDNAV_SHARED_DATA_DIR}/gnss-gsdc2021-pixel5/Pixel5_first_half.21o" --out "${CMAKE_CURRENT_BINARY_DIR}/replay-rinex")
+set_tests_properties(io_replay_rinex_obs_message PROPERTIES LABELS "io;cli"
+  PASS_REGULAR_EXPRESSION "not a recording pdnav reads: .*a RINEX observation file: `pdnav gnss` reads it")
 add_test(NAME io_inspect_one_sensorlogger_csv COMMAND pdnav inspect "${_io_walk}/Accelerometer.csv")
 set_tests_properties(io_inspect_one_sensorlogger_csv PROPERTIES LABELS "io;cli" WILL_FAIL TRUE)
 

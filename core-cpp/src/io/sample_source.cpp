@@ -208,6 +208,11 @@ Format sniff_text(const std::string& head, std::string& found) {
   if (log_lines > 0 && log_lines >= gsd_lines) return session || !gnsslogger ? Format::kSession : Format::kGnssLogger;
   if (gsd_lines > 0) return Format::kGetSensorData;
   found = first.empty() ? "no text lines" : "first line '" + detail::printable(first, 60) + "'";
+  if (first.find("RINEX VERSION") != std::string::npos || first.find("OBSERVATION DATA") != std::string::npos ||
+      first.find("NAVIGATION DATA") != std::string::npos || first.find("NAV DATA") != std::string::npos)
+    found += first.find("OBSERVATION") != std::string::npos
+                 ? " (a RINEX observation file: `pdnav gnss` reads it, with --nav)"
+                 : " (a RINEX navigation file: give it with --nav)";
   return Format::kAuto;
 }
 
