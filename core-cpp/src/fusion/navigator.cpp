@@ -157,8 +157,7 @@ struct Navigator::Impl {
   TimeNs last_gnss_ns = -1;               // last accepted GNSS (Raw or Fix) position
   TimeNs last_raw_pos_ns = -1;            // last Raw epoch with an SPP position (accepted or not)
   IntervalAverage gnss_interval;          // between accepted GNSS positions
-  bool gnss_degraded = false;             // a degraded / Fix-only one was accepted within degraded_hold_s
-  TimeNs last_degraded_gnss_ns = -1;
+  TimeNs last_degraded_gnss_ns = -1;     // last accepted degraded / Fix-only GNSS position
   std::string gnss_what;                  // description of the last accepted GNSS measurement
   std::string last_event;                 // the last notable filter event (for the reason)
   TimeNs last_raw_row_ns = -1;            // t of the last Raw row fed (pending epoch)
@@ -508,7 +507,6 @@ struct Navigator::Impl {
     if (last_gnss_ns >= 0) gnss_interval.add(static_cast<double>(t - last_gnss_ns) * 1e-9);
     last_gnss_ns = t;
     if (degraded) last_degraded_gnss_ns = t;
-    gnss_degraded = last_degraded_gnss_ns >= 0 && t - last_degraded_gnss_ns <= ns(fo().degraded_hold_s);
     gnss_what = what;
     cal.add_gnss(t, z, sigma_m);
     const PdrCalibration& p = cal.published();
@@ -768,7 +766,9 @@ struct Navigator::Impl {
     FusionMode to = FusionMode::kPdr;
     std::string why = why_in;
     if (gnss_fresh(t)) {
-      to = gnss_degraded ? FusionMode::kGnssDegraded : FusionMode::kGnss;
+      // the label holds degraded_hold_s after the last degraded position accepted
+      const bool degraded = last_degraded_gnss_ns >= 0 && last_gnss_ns - last_degraded_gnss_ns <= ns(fo().degraded_hold_s);
+      to = degraded ? FusionMode::kGnssDegraded : FusionMode::kGnss;
       if (why.empty()) why = "GNSS accepted: " + gnss_what;
     } else if (last_aid_ok_ns >= 0 && t - last_aid_ok_ns <= ns(2.0 * fo().aid_interval_s)) {
       to = aid_engine;

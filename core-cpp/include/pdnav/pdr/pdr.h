@@ -238,7 +238,8 @@ class Pdr {
   /// Online hard-iron calibration of the magnetometer feeding the compass (bias in use, active).
   const MagCalibration& mag_calibration() const { return magcal_; }
   /// The bias of an uncalibrated gyro stream that came without the platform's drift estimate,
-  /// learned while the phone lay still (gyro_bias.h); used() is false when no such stream came.
+  /// learned while the phone lay still (gyro_bias.h); gyro_bias_at_rest_used() is false when no
+  /// such stream came.
   const GyroBiasAtRest& gyro_bias_at_rest() const { return gyro_rest_; }
   bool gyro_bias_at_rest_used() const { return gyro_rest_used_; }
   /// The heading source of the emitted steps, as spans of consecutive steps.
