@@ -52,6 +52,24 @@ TEST(SampleRate, BlocksOfTheGridAreAveragedAndStampedWithTheirLastSample) {
   for (std::size_t i = 1; i < out.size(); ++i) EXPECT_LE(sample_time_ns(out[i - 1]), sample_time_ns(out[i]));
 }
 
+TEST(SampleRate, AnUnstatedBiasStaysUnstatedAndItsReadingsAreKept) {
+  // Sensor Logger's uncalibrated files carry no bias columns (NaN): the readings are still
+  // averaged (they were dropped as non-finite), the bias stays NaN for the PDR to treat as raw
+  std::vector<Sample> in;
+  for (int k = 0; k < 8; ++k) {
+    UncalMagSample m;
+    m.t_ns = 1000 * kMs + k * 5 * kMs;  // 200 Hz
+    m.field_ut = Eigen::Vector3d(k, 20.0, -40.0);
+    m.bias_ut = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    in.emplace_back(m);
+  }
+  const auto mag = only<UncalMagSample>(at_sample_rate(in, 50.0));
+  ASSERT_EQ(mag.size(), 2u);
+  EXPECT_DOUBLE_EQ(mag[0].field_ut.x(), 1.5);
+  EXPECT_DOUBLE_EQ(mag[1].field_ut.x(), 5.5);
+  EXPECT_TRUE(std::isnan(mag[0].bias_ut.x()) && std::isnan(mag[1].bias_ut.z()));
+}
+
 TEST(SampleRate, OtherStreamsAreKeptOrDecimatedAndNonFiniteReadingsLeftOut) {
   std::vector<Sample> in;
   for (int k = 0; k < 8; ++k) {

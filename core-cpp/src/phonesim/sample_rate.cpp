@@ -41,7 +41,7 @@ std::vector<Sample> at_sample_rate(const std::vector<Sample>& in, double rate_hz
   struct Block {
     bool open = false;
     TimeNs cell = 0;  // the block's cell on the grid
-    int n = 0;
+    int n = 0, n_b = 0;  // readings averaged; of them with a stated bias / drift
     Sample last;
     Eigen::Vector3d sum_a = Eigen::Vector3d::Zero(), sum_b = Eigen::Vector3d::Zero();
   };
@@ -56,7 +56,8 @@ std::vector<Sample> at_sample_rate(const std::vector<Sample>& in, double rate_hz
     Sample s = b.last;
     if (const auto [a, bias] = motion_vectors(s); a) {
       *a = b.sum_a / b.n;
-      if (bias) *bias = b.sum_b / b.n;
+      // a bias the recording does not state (NaN: Sensor Logger's uncalibrated files) stays unstated
+      if (bias) *bias = b.n_b > 0 ? Eigen::Vector3d(b.sum_b / b.n_b) : Eigen::Vector3d::Constant(std::nan(""));
     }
     out.push_back(std::move(s));
     b = Block{};
@@ -79,8 +80,9 @@ std::vector<Sample> at_sample_rate(const std::vector<Sample>& in, double rate_hz
     const TimeNs cell = t >= grid0_ns[s.index()] ? (t - grid0_ns[s.index()]) / block_ns : -1;
     if (b.open && (cell != b.cell || cell < 0)) flush(b);
     if (!b.open) b.open = true, b.cell = cell;
-    if (vec && va.allFinite() && vb.allFinite()) {
-      b.sum_a += va, b.sum_b += vb, ++b.n, b.last = s;
+    if (vec && va.allFinite()) {
+      b.sum_a += va, ++b.n, b.last = s;
+      if (vb.allFinite()) b.sum_b += vb, ++b.n_b;
     } else if (!vec) {
       b.n = 1, b.last = s;
     }

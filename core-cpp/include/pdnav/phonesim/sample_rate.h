@@ -13,7 +13,8 @@ namespace pdnav::phonesim {
 /// rate with its anti-alias averaging, what a sensor hub delivers at a lower rate. Rotation
 /// vectors and orientation angles keep the last sample of each block; every other sample as
 /// recorded. A non-finite reading is left out of its block's average (a block of only such
-/// readings is dropped). A stream below the rate keeps every sample (one at the rate keeps
+/// readings is dropped); a bias / drift the recording does not state (NaN) stays NaN, the
+/// reading averaged. A stream below the rate keeps every sample (one at the rate keeps
 /// them too unless jitter puts two in one cell of the grid, which are then averaged). The
 /// result is in time order (stable). rate_hz in (0, 1e9], else std::invalid_argument.
 std::vector<Sample> at_sample_rate(const std::vector<Sample>& in, double rate_hz);
