@@ -22,6 +22,14 @@ void MagCalibration::clear_sums() {
   pyy_ = pw_ = 0.0;
 }
 
+void MagCalibration::restart_pairs() {
+  if (gyro_live_) clear_sums();  // the sphere fit's sums hold no attitude
+  readings_.clear();
+  gyro_history_.clear();
+  pair_solved_ = false;
+  ++pair_restarts_;
+}
+
 MagCalibration::MagCalibration(const MagCalibrationOptions& options) : opt_(options) {
   for (double lag = 1.0; lag <= opt_.max_lag_s + 1e-9; lag *= 2.0) lags_ns_.push_back(s_to_ns(lag));
 }

@@ -169,14 +169,29 @@ void Pdr::feed(const UncalAccelSample& s) {
 
 void Pdr::feed(const UncalGyroSample& s) {
   Eigen::Vector3d drift = stated_bias(s.drift_radps);
-  if (!s.drift_radps.allFinite() && uncal_allowed(s.t_ns, last_cal_gyro_ns_, first_uncal_gyro_ns_)) {
-    // the logger did not export the platform's drift: ours, learned while the phone lies still
-    gyro_rest_used_ = true;
-    gyro_rest_.feed_gyro(s.t_ns, s.rate_radps);
-    drift = gyro_rest_.bias_radps();
+  bool drift_known = true;
+  if (uncal_allowed(s.t_ns, last_cal_gyro_ns_, first_uncal_gyro_ns_) && s.rate_radps.allFinite()) {
+    if (!s.drift_radps.allFinite()) {
+      // the logger did not export the platform's drift: ours, learned while the phone lies still
+      gyro_rest_used_ = true;
+      gyro_rest_.feed_gyro(s.t_ns, s.rate_radps);
+      drift = gyro_rest_.bias_radps();
+      drift_known = gyro_rest_.known();
+    }
+    // a raw rate integrates its drift (degrees per second) into the hard-iron fit's attitude,
+    // which its gyro-bias state (a residual of tenths of a degree per second) cannot absorb
+    magcal_gyro_ok_ = drift_known;
+    if (drift_known) {
+      if (magcal_drift_set_ && (drift - magcal_drift_radps_).norm() > opt_.magcal.prior_gyro_bias_radps)
+        magcal_.restart_pairs();
+      if (!magcal_drift_set_ || (drift - magcal_drift_radps_).norm() > opt_.magcal.prior_gyro_bias_radps)
+        magcal_drift_radps_ = drift;
+      magcal_drift_set_ = true;
+    }
   }
   feed_uncal(GyroSample{s.t_ns, s.utc_ms, s.rate_radps - drift}, sensors_.uncal_gyro, sensors_.gyro,
              last_cal_gyro_ns_, first_uncal_gyro_ns_);
+  magcal_gyro_ok_ = true;
 }
 
 void Pdr::feed(const UncalMagSample& s) {
@@ -515,7 +530,7 @@ void Pdr::feed(const GyroSample& s) {
   ++sensors_.gyro;
   last_cal_gyro_ns_ = s.t_ns;
   tracker_.feed(s);
-  magcal_.add_gyro(s.t_ns, s.rate_radps);  // the attitude of the gyro-aided hard-iron fit
+  if (magcal_gyro_ok_) magcal_.add_gyro(s.t_ns, s.rate_radps);  // the gyro-aided hard-iron fit's attitude
   placement_.feed(s);  // the tilt filter levels the walking-direction correlation
   classifier_.feed(s);
   detector_.feed(s);   // the stride test reads the swing from the angular rate

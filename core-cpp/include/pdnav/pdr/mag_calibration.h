@@ -111,6 +111,11 @@ class MagCalibration {
     return active_ ? Eigen::Vector3d(field_ut - bias_ut_) : field_ut;
   }
   bool active() const { return active_; }
+  /// The gyro's bias correction changed (an uncalibrated gyro's drift, learned or stated): the
+  /// attitudes before and after are not one integration, so no pair spans the change and the
+  /// pairs summed with the former correction are forgotten (the bias in use stays).
+  void restart_pairs();
+  std::int64_t pair_restarts() const { return pair_restarts_; }
   /// Time the first bias was applied (-1: never).
   TimeNs active_from_ns() const { return active_from_ns_; }
   /// The bias in use (zero while not active), sphere radius and fit residual (fraction of r)
@@ -169,7 +174,7 @@ class MagCalibration {
   Eigen::Vector3d bias_ut_ = Eigen::Vector3d::Zero();
   double last_explained_ = kNaN, last_residual_ = kNaN;
   double radius_ut_ = kNaN, residual_ = kNaN, spread_ut2_ = 0.0;
-  std::int64_t refusals_ = 0, accepted_ = 0;
+  std::int64_t refusals_ = 0, accepted_ = 0, pair_restarts_ = 0;
 };
 
 }  // namespace pdnav::pdr

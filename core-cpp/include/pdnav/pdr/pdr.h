@@ -331,6 +331,12 @@ class Pdr {
   PdrOptions opt_;
   GyroBiasAtRest gyro_rest_;
   bool gyro_rest_used_ = false;
+  // the hard-iron fit's gyro attitude (mag_calibration.h): an uncalibrated gyro whose drift is
+  // not known yet gives none; a drift correction that moved by more than the fit's gyro-bias
+  // prior since the pairs began restarts them
+  bool magcal_gyro_ok_ = true;
+  bool magcal_drift_set_ = false;
+  Eigen::Vector3d magcal_drift_radps_ = Eigen::Vector3d::Zero();
   StepDetector detector_;
   StepDetector forward_detector_;  // forward_steps: the forward acceleration channel
   TimeNs last_candidate_ns_ = -1;  // the latest step candidate of either channel
