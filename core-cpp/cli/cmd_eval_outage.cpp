@@ -74,6 +74,7 @@ struct WalkResult {
   std::string name;
   std::string reference;  // "truth" or "fixes"
   double span_s = 0, w0_s = 0, w1_s = 0;  // GNSS span, window (s from the span start)
+  bool gnss_in_log = true;  // false: no GNSS at all, the span is the reference's
   int epochs_in_window = 0;
   double fused_rms_m = kNaNd, dr_rms_m = kNaNd, fused_end_m = kNaNd, dr_end_m = kNaNd, ratio = kNaNd;
   int covered = 0;
@@ -229,14 +230,16 @@ WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std:
   if (g0 < 0) {  // no GNSS at all: the span of the reference
     g0 = refs.front().t_ns;
     g1 = refs.back().t_ns;
+    r.gnss_in_log = false;
   }
   const double span_s = static_cast<double>(g1 - g0) * 1e-9;
   r.span_s = span_s;
   double w0_s = std::isfinite(a.start_s) ? a.start_s : a.start_frac * span_s;
   double len_s = std::isfinite(a.length_s) ? a.length_s : std::min(a.length_frac * span_s, a.max_s);
+  const std::string span_name = r.gnss_in_log ? "GNSS span" : "reference span (no GNSS in the recording)";
   if (!(w0_s >= 0.0) || !(len_s > 0.0) || w0_s + len_s > span_s + 1e-9)
-    throw std::runtime_error(path + ": outage window " + f1(w0_s) + "-" + f1(w0_s + len_s) + " s is not inside the GNSS span 0-" +
-                             f1(span_s) + " s");
+    throw std::runtime_error(path + ": outage window " + f1(w0_s) + "-" + f1(w0_s + len_s) + " s is not inside the " +
+                             span_name + " 0-" + f1(span_s) + " s");
   r.w0_s = w0_s;
   r.w1_s = w0_s + len_s;
   const TimeNs w0 = g0 + static_cast<TimeNs>(w0_s * 1e9), w1 = g0 + static_cast<TimeNs>(r.w1_s * 1e9);
@@ -329,6 +332,7 @@ WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std:
     j["log"] = path;
     j["reference"] = r.reference;
     j["gnss_span_s"] = span_s;
+    j["gnss_in_log"] = r.gnss_in_log;
     j["window_s"] = {r.w0_s, r.w1_s};
     j["epochs_in_window"] = r.epochs_in_window;
     j["removed"] = {{"raw_rows", r.removed_raw}, {"fix_rows", r.removed_fix}};
@@ -383,8 +387,10 @@ int run_eval_outage(const EvalOutageArgs& a) {
     const std::string tag = a.start_fracs.empty() ? "" : "@" + f3(start).substr(0, 4);
     WalkResult r = evaluate(log, b, dem, graph, eph, out.empty() ? nullptr : &out, tag);
     const double cov = r.epochs_in_window > 0 ? static_cast<double>(r.covered) / r.epochs_in_window : kNaNd;
-    std::printf("%s: reference %s, GNSS span %.0f s, window %.0f-%.0f s (%d epochs; removed %lld Raw, %lld Fix rows)\n",
-                r.name.c_str(), r.reference.c_str(), r.span_s, r.w0_s, r.w1_s, r.epochs_in_window,
+    std::printf("%s: reference %s, %s %.0f s, window %.0f-%.0f s (%d epochs; removed %lld Raw, %lld Fix rows)\n",
+                r.name.c_str(), r.reference.c_str(),
+                r.gnss_in_log ? "GNSS span" : "reference span (no GNSS in the recording: nothing to remove)", r.span_s,
+                r.w0_s, r.w1_s, r.epochs_in_window,
                 static_cast<long long>(r.removed_raw), static_cast<long long>(r.removed_fix));
     std::printf("  fused: rms %s m, end %s m | dr: rms %s m, end %s m (start sigma %s m) | ratio %s | coverage_68 %s | "
                 "max jump %s sigma (at %s s)\n",

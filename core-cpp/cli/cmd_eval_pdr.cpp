@@ -570,8 +570,32 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a, const std::s
   if (!write_path.empty()) {  // what is scored below, replayable with `pdnav replay`
     OutputFile out(write_path, a.logs);
     io::LogWriter w(out.partial_path());
-    for (const Sample& s : samples)
-      if (sensor_set_keeps(a.sensors, s)) w.write(s);
+    // The scoring below starts the dead reckoning at the first Truth point; a log that does not
+    // state that start itself (the phone's fixes as the reference: its Fix rows become Truth)
+    // gets it as Meta rows, so `pdnav replay` of the written log starts there too.
+    const bool states_start = std::any_of(samples.begin(), samples.end(), [](const Sample& s) {
+      const auto* m = std::get_if<MetaSample>(&s);
+      return m && m->key == "StartLatitudeDegrees";
+    });
+    bool start_written = states_start;
+    for (const Sample& s : samples) {
+      if (!sensor_set_keeps(a.sensors, s)) continue;
+      if (const auto* t = std::get_if<TruthSample>(&s);
+          !start_written && t && std::isfinite(t->lat_deg) && std::isfinite(t->lon_deg)) {
+        const auto sigma = r.ref_sigma_m.find(t->t_ns);
+        const double sigma_m = sigma != r.ref_sigma_m.end() ? std::max(1.0, sigma->second) : 1.0;
+        const auto text = [](double v) {
+          std::ostringstream os;
+          os << std::setprecision(12) << v;
+          return os.str();
+        };
+        w.write(MetaSample{t->t_ns, "StartLatitudeDegrees", text(t->lat_deg)});
+        w.write(MetaSample{t->t_ns, "StartLongitudeDegrees", text(t->lon_deg)});
+        w.write(MetaSample{t->t_ns, "StartSigmaMeters", text(sigma_m)});
+        start_written = true;
+      }
+      w.write(s);
+    }
     w.close();
     out.commit();
   }
@@ -886,9 +910,11 @@ int run_eval_pdr(const EvalPdrArgs& a) {
 void register_eval_pdr(CLI::App& app) {
   auto a = std::make_shared<EvalPdrArgs>();
   CLI::App* c = app.add_subcommand("eval-pdr", "PDR on real walks with surveyed waypoints (Truth lines) or the phone's fixes: errors per walk");
-  c->add_option("logs", a->logs, "session logs with Truth lines (tools/ilc2log converts the ILC walks)")
+  c->add_option("logs", a->logs,
+                "session logs with Truth lines (tools/ilc2log converts the ILC walks) or the phone's fixes; any recording "
+                "replay reads (Sensor Logger / phyphox folder or zip, GetSensorData log)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingPath);
   c->add_option("--mount", a->mount, "auto | chest | chest-camera-out | chest-screen-out | hand")->capture_default_str();
   c->add_option("--via", a->via, "navigator (= replay --engine dr) | pdr (direct, for --length)")->capture_default_str();
   c->add_option("--length", a->length, "with --via pdr: default | apt | weinberg | frequency | constant")

@@ -391,11 +391,17 @@ void run_gnss(const GnssArgs& a) {
                 "Doppler %.1f / %.1f / %.1f cm (%d epochs)\n",
                 te.x(), te.y(), te.z(), t.tdcp_epochs, de.x(), de.y(), de.z(), t.doppler_epochs);
   }
-  const double nan = kNaN;
-  std::printf("spp_p50_h_m: %.2f spp_p95_h_m: %.2f kf_rms_h_m: %.2f tdcp_rms_cm: %.2f kf_cov68: %.3f\n",
-              have_truth ? acc.spp_p50_h_m : nan, have_truth ? acc.spp_p95_h_m : nan,
-              have_truth ? acc.kf_rms_h_m : nan, tdcp_rms_m * 100.0,
-              have_truth ? acc.kf_coverage68 : nan);
+  // the static figures need --truth (a surveyed point); n/a, not NaN, where there is none
+  const auto fig = [](bool known, double v, int digits) {
+    if (!known || !std::isfinite(v)) return std::string("n/a");
+    char b[32];
+    std::snprintf(b, sizeof b, "%.*f", digits, v);
+    return std::string(b);
+  };
+  std::printf("spp_p50_h_m: %s spp_p95_h_m: %s kf_rms_h_m: %s tdcp_rms_cm: %s kf_cov68: %s\n",
+              fig(have_truth, acc.spp_p50_h_m, 2).c_str(), fig(have_truth, acc.spp_p95_h_m, 2).c_str(),
+              fig(have_truth, acc.kf_rms_h_m, 2).c_str(), fig(true, tdcp_rms_m * 100.0, 2).c_str(),
+              fig(have_truth, acc.kf_coverage68, 3).c_str());
 }
 
 }  // namespace

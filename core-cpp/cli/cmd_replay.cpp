@@ -84,6 +84,22 @@ nlohmann::json fusion_summary(const fusion::Navigator& nav) {
           {"pdr_calibration", pdr_calibration_json(cal)}};
 }
 
+/// Why a replay produced no position at all (an empty track is an error, not a success).
+std::string no_estimate_reason(const fusion::Navigator& nav, const io::ReadStats& stats) {
+  const fusion::NavigatorOutput o = nav.output(0);
+  const auto count = [&stats](const char* type) {
+    const auto it = stats.samples_by_type.find(type);
+    return it == stats.samples_by_type.end() ? std::int64_t{0} : it->second;
+  };
+  if (o.mode == fusion::FusionMode::kNotStarted)
+    return "no position estimated: the log gives no start position (no Meta StartLatitudeDegrees / "
+           "StartLongitudeDegrees, no GNSS Fix row, no Raw measurements with navigation data: --nav or Nav rows); "
+           "give one with --start LAT,LON[,SIGMA_M] (" + std::to_string(o.steps) + " steps detected, " +
+           std::to_string(count("Fix")) + " Fix rows, " + std::to_string(count("Raw")) + " Raw rows)";
+  return "no position estimated: the Navigator started but gave no valid estimate (" + std::to_string(o.steps) +
+         " steps detected)";
+}
+
 int run_replay(const ReplayArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   std::filesystem::create_directories(a.out_dir);
@@ -216,9 +232,10 @@ int run_replay(const ReplayArgs& a) {
     std::cout << "drms_m: " << st.drms_m << " rms_e_m: " << st.rms_e_m << " rms_n_m: " << st.rms_n_m
               << " p50_h_m: " << st.p50_h_m << " p95_h_m: " << st.p95_h_m
               << " coverage_1sigma: " << st.coverage_1sigma << " coverage_68: " << st.coverage_68 << "\n";
-  } else {
+  } else if (!rec.epochs().empty()) {
     std::cout << "reference: none (no Truth or GPS Fix lines): no error statistics\n";
   }
+  if (rec.epochs().empty()) throw std::runtime_error(a.log + ": " + no_estimate_reason(nav, reader.stats()));
   return 0;
 }
 

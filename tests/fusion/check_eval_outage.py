@@ -5,7 +5,8 @@ the options put it and the GNSS rows in it were removed; (3) the figures are wit
 sessions pooled (fused beats dead reckoning restarted at the last fix, the fused 68 % region
 holds the truth about as often as it says, no jump beyond 3 sigma when GNSS returns); (4) the per-walk CSV
 and JSON exist and agree with the printed figures; (5) dead reckoning starts at the last fix;
-(6) bad input is a clear error: a log without any reference, a window outside the GNSS span.
+(6) bad input is a clear error: a log without any reference, a window outside the GNSS span; a
+log without GNSS is scored on its reference's span and says so.
 
   check_eval_outage.py PDNAV DEM GRAPH NAV SCRATCH_DIR
 """
@@ -154,6 +155,23 @@ def main(argv):
     r4 = run([pdnav, "eval-outage", bare, "--quiet"], ok=False)
     if r4.returncode == 0 or "no reference" not in (r4.stdout + r4.stderr) or "no_reference.log" not in r4.stderr:
         failures.append(f"log without reference: exit {r4.returncode}, {r4.stderr.strip()}")
+    # a recording with Truth but no GNSS at all: the window is on the reference's span, and the
+    # line says so (nothing was removed), not "GNSS span"
+    no_gnss = os.path.join(scratch, "no_gnss.log")
+    with open(log) as f, open(no_gnss, "w") as g:
+        started = False
+        for ln in f:
+            if ln.startswith("Truth,") and not started:  # the start the fixes gave, stated
+                _, t, lat, lon = ln.split(",")[:4]
+                g.write(f"Meta,{t},StartLatitudeDegrees,{lat}\nMeta,{t},StartLongitudeDegrees,{lon}\n"
+                        f"Meta,{t},StartSigmaMeters,3\n")
+                started = True
+            if not ln.startswith(("Fix,", "Raw,", "Nav,")):
+                g.write(ln)
+    r5 = run([pdnav, "eval-outage", no_gnss, "--quiet"], ok=False)
+    if r5.returncode != 0 or "reference truth, reference span (no GNSS in the recording: nothing to remove)" not in r5.stdout \
+            or "removed 0 Raw, 0 Fix rows" not in r5.stdout:
+        failures.append(f"log without GNSS: exit {r5.returncode}, {r5.stdout[-300:]} {r5.stderr.strip()}")
     if failures:
         sys.exit("FAIL: " + "; ".join(failures))
     print("ok")

@@ -319,11 +319,13 @@ nlohmann::json pdr_calibration_json(const fusion::PdrCalibration& c) {
 }
 
 std::string accel_rate_warning(double rate_hz) {
-  char b[256];
+  char b[320];
+  char every[64] = "";
+  if (rate_hz > 0.0 && rate_hz < 1.0) std::snprintf(every, sizeof every, " (a sample every %.0f s)", 1.0 / rate_hz);
   std::snprintf(b, sizeof b,
-                "accelerometer at %.0f Hz: the step detector is measured at 50-200 Hz and misses steps below %.0f Hz "
+                "accelerometer at %.3g Hz%s: the step detector is measured at 50-200 Hz and misses steps below %.0f Hz "
                 "(TYREX at 25 Hz: median step error 10 %%, length ratio 0.83; at 10 Hz 0.28); record at 50 Hz or more",
-                rate_hz, pdr::Pdr::kMinAccelRateHz);
+                rate_hz, every, pdr::Pdr::kMinAccelRateHz);
   return b;
 }
 
@@ -372,6 +374,7 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
                           {"active_from_s", cal.active_from_ns() >= 0 ? nlohmann::json(ns_to_s(cal.active_from_ns() - t0_ns)) : nlohmann::json()},
                           {"gyro_bias_dps", {rad_to_deg(cal.gyro_bias_radps().x()), rad_to_deg(cal.gyro_bias_radps().y()), rad_to_deg(cal.gyro_bias_radps().z())}},
                           {"pairs_gated", cal.pairs_gated()},
+                          {"pair_restarts", cal.pair_restarts()},
                           {"pair_residual_ut", std::isfinite(cal.pair_residual_ut()) ? nlohmann::json(cal.pair_residual_ut()) : nlohmann::json()},
                           {"bias_sigma_ut", std::isfinite(cal.bias_sigma_ut()) ? nlohmann::json(cal.bias_sigma_ut()) : nlohmann::json()},
                           {"fits_accepted", cal.fits_accepted()},
