@@ -58,6 +58,13 @@ add_test(NAME io_replay_rinex_obs_message
          COMMAND pdnav replay "${PDNAV_SHARED_DATA_DIR}/gnss-gsdc2021-pixel5/Pixel5_first_half.21o" --out "${CMAKE_CURRENT_BINARY_DIR}/replay-rinex")
 set_tests_properties(io_replay_rinex_obs_message PROPERTIES LABELS "io;cli"
   PASS_REGULAR_EXPRESSION "not a recording pdnav reads: .*a RINEX observation file: `pdnav gnss` reads it")
+# the other shared files a field tester may pass by mistake say which command and option take
+# them: an SP3 orbit file, a GSDC truth table, an Oxford step-counter CSV (exit non-zero each)
+add_test(NAME io_replay_other_kinds_message
+         COMMAND sh -c "for f in \"$1/gnss-orbits-2023-073/COD0OPSRAP_20230730000_01D_05M_ORB.SP3\" \"$1/gnss-gsdc2021-pixel5/ground_truth_first_half.csv\" \"$1/steps-oxford/user1_hand_1506421989895.csv\"; do \"$0\" replay \"$f\" --out \"$2\" --quiet 2>&1; echo \"rc=$?\"; done"
+                 $<TARGET_FILE:pdnav> "${PDNAV_SHARED_DATA_DIR}" "${CMAKE_CURRENT_BINARY_DIR}/replay-other-kinds")
+set_tests_properties(io_replay_other_kinds_message PROPERTIES LABELS "io;cli"
+  PASS_REGULAR_EXPRESSION "an SP3 precise orbit file: `pdnav gnss` and `pdnav orbits` take it with --sp3.\nrc=1\n.*a GSDC ground-truth table: `pdnav gnss` takes it with --truth-csv.\nrc=1\n.*an Oxford step-counter CSV. `pdnav steps --format oxford` reads it.\nrc=1\n")
 add_test(NAME io_inspect_one_sensorlogger_csv COMMAND pdnav inspect "${_io_walk}/Accelerometer.csv")
 set_tests_properties(io_inspect_one_sensorlogger_csv PROPERTIES LABELS "io;cli" WILL_FAIL TRUE)
 

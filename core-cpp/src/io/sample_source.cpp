@@ -213,6 +213,13 @@ Format sniff_text(const std::string& head, std::string& found) {
     found += first.find("OBSERVATION") != std::string::npos
                  ? " (a RINEX observation file: `pdnav gnss` reads it, with --nav)"
                  : " (a RINEX navigation file: give it with --nav)";
+  else if (first.size() >= 3 && first[0] == '#' && (first[1] == 'c' || first[1] == 'd') && (first[2] == 'P' || first[2] == 'V'))
+    found += " (an SP3 precise orbit file: `pdnav gnss` and `pdnav orbits` take it with --sp3)";
+  else if (first.rfind("collectionName,phoneName,millisSinceGpsEpoch,latDeg,lngDeg", 0) == 0)
+    found += " (a GSDC ground-truth table: `pdnav gnss` takes it with --truth-csv)";
+  else if (!first.empty() && first.find_first_not_of("0123456789.,-+eE \t\r") == std::string::npos &&
+           std::count(first.begin(), first.end(), ',') == 6)
+    found += " (numbers without a header, 7 columns: an Oxford step-counter CSV? `pdnav steps --format oxford` reads it)";
   return Format::kAuto;
 }
 
