@@ -22,6 +22,7 @@
 #include "pdnav/io/sample_source.h"
 #include "pdnav/pdr/pdr.h"
 #include "support/pdr_oxford.h"
+#include "support/replay_support.h"
 
 namespace pdnav::cli {
 namespace {
@@ -51,6 +52,7 @@ struct FileResult {
   std::vector<PdrTurn> turns;
   std::vector<PdrStep> steps;
   std::string heading_frame;  // how the headings are referenced (true north via WMM, or magnetic)
+  std::string rate_warning;   // the accelerometer's rate is below what the detector is measured at
   double max_delay_s = 0.0, max_delay_at_s = 0.0;  // longest step-to-emission latency, that step's time
 };
 
@@ -128,7 +130,8 @@ void feed_sample(pdr::Pdr& engine, const Sample& s) {
         using T = std::decay_t<decltype(x)>;
         if constexpr (std::is_same_v<T, AccelSample> || std::is_same_v<T, GyroSample> ||
                       std::is_same_v<T, MagSample> || std::is_same_v<T, RotationVectorSample> ||
-                      std::is_same_v<T, StepDetectorSample>) {
+                      std::is_same_v<T, StepDetectorSample> || std::is_same_v<T, UncalAccelSample> ||
+                      std::is_same_v<T, UncalGyroSample> || std::is_same_v<T, UncalMagSample>) {
           engine.feed(x);
         }
       },
@@ -160,6 +163,8 @@ FileResult run_log(const std::string& path, const pdr::PdrOptions& options) {
   engine.finish();  // a walk too short for the bout gate still counts (issue 19.6)
   for (auto& st : engine.take_steps()) r.steps.push_back(st);
   r.heading_frame = describe_frame(engine, start);
+  if (const double hz = engine.accel_rate_hz(); std::isfinite(hz) && hz < pdr::Pdr::kMinAccelRateHz)
+    r.rate_warning = accel_rate_warning(hz);
   r.detected = engine.step_count();
   r.duration_s = first ? 0.0 : ns_to_s(t1 - t0);
   r.counters = engine.counters().accel;
@@ -167,7 +172,17 @@ FileResult run_log(const std::string& path, const pdr::PdrOptions& options) {
   r.android_events = engine.counters().step_detector.accepted;
   r.consistency = engine.consistency();
   if (reader.stats().skipped_total() > 0) {
-    std::cerr << path << ": " << reader.stats().skipped_total() << " malformed lines skipped\n";
+    std::cerr << path << ": " << reader.stats().skipped_total() << " lines skipped by the reader";
+    if (!reader.stats().issues.empty()) std::cerr << " (first: " << reader.stats().issues.front().to_string() << ")";
+    std::cerr << "\n";
+  }
+  const pdr::PdrSensorSet& set = engine.sensor_set();
+  if (set.accel + set.uncal_accel + set.step_detector == 0) {
+    std::string types;
+    for (const auto& [type, n] : reader.stats().samples_by_type)
+      types += (types.empty() ? "" : ", ") + type + " " + std::to_string(n);
+    throw std::runtime_error(path + ": no accelerometer or step-detector samples, no steps to detect (the recording holds " +
+                             (types.empty() ? std::string("no samples") : types) + ")");
   }
   return r;
 }
@@ -212,6 +227,7 @@ void print_file(const FileResult& r, bool list) {
   if (r.truth >= 0) std::printf(", truth %lld", static_cast<long long>(r.truth));
   std::printf("\n");
   if (!r.heading_frame.empty()) std::printf("  %s\n", r.heading_frame.c_str());
+  if (!r.rate_warning.empty()) std::printf("  warning: %s\n", r.rate_warning.c_str());
   if (r.detected > 0) std::printf("  step latency: max %.2f s (the step at %.1f s)\n", r.max_delay_s, r.max_delay_at_s);
   const auto& c = r.counters;
   if (c.skipped() > 0 || c.gaps > 0) {

@@ -196,3 +196,14 @@ add_test(NAME pdr_cli_eval_pdr_logger_fixes_written_log_replays
                  $<TARGET_FILE:pdnav> "${_pdr_eth}" "${PROJECT_BINARY_DIR}/test-scratch/pdr-eth-fixes")
 set_tests_properties(pdr_cli_eval_pdr_logger_fixes_written_log_replays PROPERTIES LABELS "pdr;cli" TIMEOUT 120
                      PASS_REGULAR_EXPRESSION "steps +867 mean_err_m +(4[0-9]|5[0-9])\\.[0-9]+ .*\nepochs: +8[0-9][0-9]\nreference: truth \\(8[0-9][0-9] epochs\\)\nno start: rc=1\n.*no position estimated: the log gives no start position")
+
+# `pdnav steps` reads the uncalibrated streams as replay does: a recording with only the
+# uncalibrated gyroscope (eval-pdr --sensors uncal, written) counts the steps of the calibrated
+# one (85 of the TYREX texting walk; 91 when steps ignored the UncalGyro rows); a recording
+# without an accelerometer or step events is an error naming what it holds, not "0 steps".
+add_test(NAME pdr_cli_steps_uncal_and_no_motion
+         COMMAND sh -c "d=\"$2\"; rm -rf \"$d\"; mkdir -p \"$d\" || exit 1; \"$0\" eval-pdr --quiet --sensors uncal --write-logs \"$d\" \"$1\" >/dev/null 2>&1 || exit 1; f=\"$d/$(basename \"$1\")\"; echo \"uncal gyro rows $(grep -c '^UncalGyro,' \"$f\"), gyro rows $(grep -c '^Gyro,' \"$f\")\"; a=$(\"$0\" steps --source auto --mount handheld \"$1\" | head -1 | sed 's/^[^:]*: //'); b=$(\"$0\" steps --source auto --mount handheld \"$f\" | head -1 | sed 's/^[^:]*: //'); echo \"calibrated: $a\"; echo \"uncalibrated: $b\"; [ -n \"$a\" ] && [ \"$a\" = \"$b\" ] && echo same; \"$0\" steps \"$3\" >/dev/null 2>\"$d/err.txt\"; echo \"no motion: rc=$?\"; cat \"$d/err.txt\""
+                 $<TARGET_FILE:pdnav> "${_pdr_tyrex_out}/logs/tyrex/Guillaume_Nexus5_NoDist_Texting.log" "${PROJECT_BINARY_DIR}/test-scratch/pdr-steps-uncal"
+                 "${PDNAV_SHARED_DATA_DIR}/gnss-mountainview/pseudoranges_log_2016_08_22_14_45_50.txt")
+set_tests_properties(pdr_cli_steps_uncal_and_no_motion PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex TIMEOUT 120
+                     PASS_REGULAR_EXPRESSION "uncal gyro rows [1-9][0-9]+, gyro rows 0\ncalibrated: [1-9][0-9]+ steps in [^\n]*\nuncalibrated: [^\n]*\nsame\nno motion: rc=1\n.*no accelerometer or step-detector samples, no steps to detect \\(the recording holds Fix 206, Raw 5041\\)")
