@@ -842,10 +842,12 @@ int run_eval_pdr(const EvalPdrArgs& a) {
     }
     if (json) json << walk_json(all.back(), a).dump() << "\n";
     const WalkResult& r = all.back();
-    std::printf("%-48s wps %2zu steps %4lld mean_err_m %6.2f max %6.2f ratio %5.3f seg_heading_median %+5.1f | naive %6.2f ratio %5.3f\n",
+    std::printf("%-48s wps %2zu steps %4lld mean_err_m %6.2f max %6.2f ratio %5.3f seg_heading_median %+5.1f | ",
                 r.name.c_str(), r.errors_m.size() + 1, static_cast<long long>(r.steps), r.mean_m,
                 *std::max_element(r.errors_m.begin(), r.errors_m.end()), r.length_ratio,
-                median(r.seg_heading_err_deg), r.naive_mean_m, r.naive_ratio);
+                median(r.seg_heading_err_deg));
+    if (std::isfinite(r.naive_mean_m)) std::printf("naive %6.2f ratio %5.3f\n", r.naive_mean_m, r.naive_ratio);
+    else std::printf("naive n/a (no rotation vector: its heading)\n");
     if (r.reference == "fixes")
       std::printf("    reference: the phone's GPS fixes, %lld scored (accuracy <= %.1f m), %lld others not\n",
                   static_cast<long long>(r.fixes_used), a.fix_max_accuracy_m, static_cast<long long>(r.fixes_rejected));
@@ -870,12 +872,17 @@ int run_eval_pdr(const EvalPdrArgs& a) {
   }
   std::vector<double> abs_herr;
   for (double h : herr) abs_herr.push_back(std::abs(h));
-  std::printf("walks %zu (failed %d); better than naive in %d; naive median_mean_error_m %.2f\n", all.size(), failed, wins,
-              median(naive_means));
+  const bool any_naive = std::any_of(naive_means.begin(), naive_means.end(), [](double v) { return std::isfinite(v); });
+  if (any_naive)
+    std::printf("walks %zu (failed %d); better than naive in %d; naive median_mean_error_m %.2f\n", all.size(), failed, wins,
+                median(naive_means));
+  else
+    std::printf("walks %zu (failed %d); naive PDR n/a (no walk has a rotation vector)\n", all.size(), failed);
   std::printf("segment heading error: median signed %.1f deg, median |.| %.1f deg over %zu segments; WMM declination %.1f deg\n",
               median(herr), median(abs_herr), herr.size(), all.front().declination_deg);
-  std::printf("naive (rotation vector +Y, magnetic, no declination): segment heading error median signed %.1f deg\n",
-              median(naive_herr));
+  if (any_naive)
+    std::printf("naive (rotation vector +Y, magnetic, no declination): segment heading error median signed %.1f deg\n",
+                median(naive_herr));
   std::int64_t qsf_tested = 0, qsf_static = 0;
   for (const auto& r : all) qsf_tested += r.qsf_tested, qsf_static += r.qsf_static;
   if (qsf_tested > 0)
