@@ -28,6 +28,7 @@
 #include "pdnav/gnss/sp3.h"
 #include "pdnav/io/log_reader.h"
 #include "pdnav/io/sample_source.h"
+#include "support/eval_support.h"
 #include "support/sources.h"
 
 namespace pdnav::cli {
@@ -392,16 +393,10 @@ void run_gnss(const GnssArgs& a) {
                 te.x(), te.y(), te.z(), t.tdcp_epochs, de.x(), de.y(), de.z(), t.doppler_epochs);
   }
   // the static figures need --truth (a surveyed point); n/a, not NaN, where there is none
-  const auto fig = [](bool known, double v, int digits) {
-    if (!known || !std::isfinite(v)) return std::string("n/a");
-    char b[32];
-    std::snprintf(b, sizeof b, "%.*f", digits, v);
-    return std::string(b);
-  };
+  const auto fig = [have_truth](double v, int digits) { return fixed_or(have_truth ? v : kNaN, digits, "n/a"); };
   std::printf("spp_p50_h_m: %s spp_p95_h_m: %s kf_rms_h_m: %s tdcp_rms_cm: %s kf_cov68: %s\n",
-              fig(have_truth, acc.spp_p50_h_m, 2).c_str(), fig(have_truth, acc.spp_p95_h_m, 2).c_str(),
-              fig(have_truth, acc.kf_rms_h_m, 2).c_str(), fig(true, tdcp_rms_m * 100.0, 2).c_str(),
-              fig(have_truth, acc.kf_coverage68, 3).c_str());
+              fig(acc.spp_p50_h_m, 2).c_str(), fig(acc.spp_p95_h_m, 2).c_str(), fig(acc.kf_rms_h_m, 2).c_str(),
+              fixed_or(tdcp_rms_m * 100.0, 2, "n/a").c_str(), fig(acc.kf_coverage68, 3).c_str());
 }
 
 }  // namespace

@@ -182,11 +182,9 @@ void Pdr::feed(const UncalGyroSample& s) {
     // which its gyro-bias state (a residual of tenths of a degree per second) cannot absorb
     magcal_gyro_ok_ = drift_known;
     if (drift_known) {
-      if (magcal_drift_set_ && (drift - magcal_drift_radps_).norm() > opt_.magcal.prior_gyro_bias_radps)
-        magcal_.restart_pairs();
-      if (!magcal_drift_set_ || (drift - magcal_drift_radps_).norm() > opt_.magcal.prior_gyro_bias_radps)
-        magcal_drift_radps_ = drift;
-      magcal_drift_set_ = true;
+      const bool moved = magcal_drift_set_ && (drift - magcal_drift_radps_).norm() > opt_.magcal.prior_gyro_bias_radps;
+      if (moved) magcal_.restart_pairs();
+      if (moved || !magcal_drift_set_) magcal_drift_radps_ = drift, magcal_drift_set_ = true;
     }
   }
   feed_uncal(GyroSample{s.t_ns, s.utc_ms, s.rate_radps - drift}, sensors_.uncal_gyro, sensors_.gyro,
