@@ -19,6 +19,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -79,6 +80,7 @@ struct EvalPdrArgs {
   double pitch_deg = 0.0;     // every walk with the phone pitched this much further (0 = as recorded)
   double rate_hz = 0.0;       // motion sensors block-averaged to at most this rate (0 = as recorded)
   double turn_deg = 0.0;      // every walk with the phone turned this much in the hand about its Z axis
+  std::vector<double> hard_iron_ut;  // every walk's magnetometer with this hard iron left in it (empty = as recorded)
   std::string sensors = "all";  // sensor set kept from each log (sensor_set_keeps)
   double segment_min_m = 0.0;   // 0: a segment per Truth line (surveyed waypoints)
   double align_start_s = 0.0;   // 0: no alignment (absolute tracks)
@@ -368,6 +370,43 @@ std::vector<Sample> read_samples(const std::string& path) {
 
 std::vector<Sample> rotated_phone(const std::vector<Sample>& in, const Eigen::AngleAxisd& rot);
 
+/// The walk with a hard iron the phone did not calibrate out (--hard-iron, phone axes, uT): added to
+/// every magnetometer reading, calibrated or not (an uncalibrated reading's stated bias does not
+/// know it), as a phone whose calibration has not converged (Android accuracy 0-1) or a raw iOS
+/// magnetometer records it. The rotation vectors and orientation angles the phone computed from
+/// its own field would carry it too and cannot be recomputed here: they are dropped (the naive
+/// PDR, which reads them, then has no heading); the game rotation vector uses no magnetometer.
+/// "x,y,z" in uT, each finite and within +-1000 (a phone's hard iron is tens of uT); throws
+/// CLI::ValidationError naming what was given.
+std::vector<double> parse_hard_iron(const std::string& text) {
+  std::vector<double> v;
+  std::stringstream in(text);
+  std::string part;
+  bool ok = true;
+  while (ok && std::getline(in, part, ',')) {
+    char* end = nullptr;
+    const double x = std::strtod(part.c_str(), &end);
+    ok = !part.empty() && end == part.c_str() + part.size() && std::isfinite(x) && std::abs(x) <= 1000.0;
+    v.push_back(x);
+  }
+  if (!ok || v.size() != 3)
+    throw CLI::ValidationError("expected x,y,z in uT (three numbers within +-1000), got '" + text + "'");
+  return v;
+}
+
+std::vector<Sample> with_hard_iron(const std::vector<Sample>& in, const std::vector<double>& b) {
+  const Eigen::Vector3d bias(b.at(0), b.at(1), b.at(2));
+  std::vector<Sample> out;
+  out.reserve(in.size());
+  for (Sample s : in) {
+    if (std::holds_alternative<RotationVectorSample>(s) || std::holds_alternative<OrientationSample>(s)) continue;
+    if (auto* m = std::get_if<MagSample>(&s)) m->field_ut += bias;
+    if (auto* m = std::get_if<UncalMagSample>(&s)) m->field_ut += bias;
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
 /// The walk with the phone pitched --pitch degrees further, top edge up, about the walk's
 /// horizontal lateral axis (+Y x the mean gravity, phone axes): the same physical walk with the
 /// phone held at another pitch, the top edge's heading kept (a reader holds a phone at 28-65 deg,
@@ -567,6 +606,7 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a, const std::s
   if (a.turn_deg != 0.0) samples = with_turn(samples, a.turn_deg);
   if (a.pitch_deg != 0.0) samples = with_pitch(samples, a.pitch_deg, path);
   if (a.wave_s > 0.0) samples = with_waving(samples, a, path, &walk_start_ns);
+  if (!a.hard_iron_ut.empty()) samples = with_hard_iron(samples, a.hard_iron_ut);
   if (!write_path.empty()) {  // what is scored below, replayable with `pdnav replay`
     OutputFile out(write_path, a.logs);
     io::LogWriter w(out.partial_path());
@@ -954,6 +994,11 @@ void register_eval_pdr(CLI::App& app) {
                  "every walk with the phone turned this much in the hand about its screen's normal (deg, + = "
                  "counter-clockwise seen from the screen; 90 = held in landscape): the same walk, another grip")
       ->check(CLI::Range(-180.0, 180.0));
+  c->add_option("--hard-iron",
+                 "every walk with this hard iron (x,y,z uT, phone axes) left in its magnetometer readings, as a "
+                 "phone whose calibration has not converged records them: the same walk, another phone (its "
+                 "rotation vectors, computed from that field, are dropped)")
+      ->each([a](const std::string& text) { a->hard_iron_ut = parse_hard_iron(text); });
   c->add_option("--pitch", a->pitch_deg,
                  "every walk with the phone pitched this much further (deg, top edge up) about the walk's "
                  "horizontal lateral axis: the same walk, the phone held at another pitch")

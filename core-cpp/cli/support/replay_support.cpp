@@ -376,6 +376,7 @@ nlohmann::json pdr_summary_json(const pdr::Pdr& pdr, std::int64_t navigator_step
                           {"pairs_gated", cal.pairs_gated()},
                           {"pair_restarts", cal.pair_restarts()},
                           {"pair_residual_ut", std::isfinite(cal.pair_residual_ut()) ? nlohmann::json(cal.pair_residual_ut()) : nlohmann::json()},
+                          {"explained", std::isfinite(cal.last_explained()) ? nlohmann::json(cal.last_explained()) : nlohmann::json()},
                           {"bias_sigma_ut", std::isfinite(cal.bias_sigma_ut()) ? nlohmann::json(cal.bias_sigma_ut()) : nlohmann::json()},
                           {"fits_accepted", cal.fits_accepted()},
                           {"fits_refused", cal.refusals()}};

@@ -153,9 +153,12 @@ void MagCalibration::add_pairs(TimeNs t_ns, const Eigen::Vector3d& m, double dt_
   pair_solved_ = true;
   const double chi2 = std::max(0.0, pyy_ - 2.0 * x.dot(pr_) + x.dot(pn_ * x));
   pair_residual_ut_ = std::sqrt(chi2 / pw_);
+  // the fraction of the pairs' differences the hard iron (and gyro bias) account for
+  last_explained_ = pyy_ > 0.0 ? 1.0 - chi2 / pyy_ : 0.0;
   const double radius = (m - b).norm();
   last_residual_ = radius > 0.0 ? pair_residual_ut_ / radius : kNaN;
-  if (!b.allFinite() || !(pair_residual_ut_ <= opt_.max_pair_residual_ut) || b.norm() > opt_.max_bias_ut) {
+  const bool fits = pair_residual_ut_ <= opt_.max_pair_residual_ut || last_explained_ >= opt_.min_pair_explained;
+  if (!b.allFinite() || !fits || b.norm() > opt_.max_bias_ut) {
     ++refusals_;  // the field changes from place to place: forget the window (the bias in use stays)
     clear_sums();
     pair_solved_ = false;
