@@ -185,6 +185,12 @@ Track replay(const std::vector<Sample>& samples, const fusion::NavigatorConfig& 
   return tr;
 }
 
+/// What the outage window is cut from: the GNSS span, or (a recording without GNSS) the span of
+/// its reference positions, with nothing to remove.
+std::string span_label(bool gnss_in_log) {
+  return gnss_in_log ? "GNSS span" : "reference span (no GNSS in the recording: nothing to remove)";
+}
+
 WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std::shared_ptr<const terrain::Dem>& dem,
                     const std::shared_ptr<const route::WalkGraph>& graph,
                     const std::shared_ptr<const gnss::EphemerisStore>& eph, const std::filesystem::path* out_dir,
@@ -236,7 +242,7 @@ WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std:
   r.span_s = span_s;
   double w0_s = std::isfinite(a.start_s) ? a.start_s : a.start_frac * span_s;
   double len_s = std::isfinite(a.length_s) ? a.length_s : std::min(a.length_frac * span_s, a.max_s);
-  const std::string span_name = r.gnss_in_log ? "GNSS span" : "reference span (no GNSS in the recording)";
+  const std::string span_name = span_label(r.gnss_in_log);
   if (!(w0_s >= 0.0) || !(len_s > 0.0) || w0_s + len_s > span_s + 1e-9)
     throw std::runtime_error(path + ": outage window " + f1(w0_s) + "-" + f1(w0_s + len_s) + " s is not inside the " +
                              span_name + " 0-" + f1(span_s) + " s");
@@ -389,7 +395,7 @@ int run_eval_outage(const EvalOutageArgs& a) {
     const double cov = r.epochs_in_window > 0 ? static_cast<double>(r.covered) / r.epochs_in_window : kNaNd;
     std::printf("%s: reference %s, %s %.0f s, window %.0f-%.0f s (%d epochs; removed %lld Raw, %lld Fix rows)\n",
                 r.name.c_str(), r.reference.c_str(),
-                r.gnss_in_log ? "GNSS span" : "reference span (no GNSS in the recording: nothing to remove)", r.span_s,
+                span_label(r.gnss_in_log).c_str(), r.span_s,
                 r.w0_s, r.w1_s, r.epochs_in_window,
                 static_cast<long long>(r.removed_raw), static_cast<long long>(r.removed_fix));
     std::printf("  fused: rms %s m, end %s m | dr: rms %s m, end %s m (start sigma %s m) | ratio %s | coverage_68 %s | "
