@@ -64,6 +64,18 @@ add_test(NAME pdr_cli_eval_pdr
 # all three walks within 6 m mean error (they are 2.4-5 m today; the legacy engine: > 10 m)
 set_tests_properties(pdr_cli_eval_pdr PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_ilc
                      PASS_REGULAR_EXPRESSION "walks 3 \\(failed 0\\).*median_mean_error_m: [0-5]\\.[0-9]+ median_length_ratio: [01]\\.[0-9]+\n")
+# The same walks held in landscape (eval-pdr --turn 90 / -90: the phone turned a quarter in the
+# hand): the hand pitches the phone about the body's lateral axis, now its Y axis, so the walking
+# line is +-X; the median segment heading error stays within 30 deg either way (-1 / -0 deg;
+# 91 / 87 deg off when a flat phone always walked along +-Y).
+add_test(NAME pdr_cli_eval_pdr_landscape
+         COMMAND sh -c "for t in 90 -90; do \"$0\" eval-pdr --quiet --turn $t \"$@\" 2>&1 | grep '^segment heading error'; done"
+                 $<TARGET_FILE:pdnav>
+                 "${_pdr_ilc_out}/site2_F3_5dd38fff44333f00067aa387.log"
+                 "${_pdr_ilc_out}/site2_F3_5dd398c544333f00067aa431.log"
+                 "${_pdr_ilc_out}/site1_F4_5ddb656fc5b77e0006b1792e.log")
+set_tests_properties(pdr_cli_eval_pdr_landscape PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_ilc
+                     PASS_REGULAR_EXPRESSION "median signed -?([0-9]|[12][0-9])\\.[0-9] deg, median \\|\\.\\| ([0-9]|[12][0-9])\\.[0-9] deg[^\n]*\n[^\n]*median signed -?([0-9]|[12][0-9])\\.[0-9] deg, median \\|\\.\\| ([0-9]|[12][0-9])\\.[0-9] deg")
 # The same walks "as recorded": 30 s of synthesised compass-calibration waving at the first
 # waypoint before each (phonesim/handling.h): no walk may get more than 2 steps from it, and the
 # track must stay usable (the naive PDR counts ~46 steps in it and is ~20 m off).

@@ -44,6 +44,7 @@ void PlacementEstimator::start_bout(TimeNs t_ns) {
   sum_up_walk_.setZero();
   var_v_ = n_corr_ = walking_s_ = swing_sq_ = swing_n_ = 0.0;
   prior_supported_ = reversed_ = prior_rejected_ = bout_levelled_ = false;
+  flat_axis_ = Eigen::Vector3d::UnitY();
   // placement from the dominant gravity axis; the reference axis is the placement's prior
   // walking axis (flat: +Y, upright: -Z), else the most horizontal of +X, +Y, -Z
   const double ax = std::abs(up_.x()), ay = std::abs(up_.y()), az = std::abs(up_.z());
@@ -201,7 +202,10 @@ void PlacementEstimator::feed(const AccelSample& s, bool walking) {
       var_v_band_ += av_band * av_band;
       band_walking_s_ += dt;
     }
-    if (level) {  // the horizontal part of the gait-band angular rate about the instantaneous gravity
+    // the horizontal part of the gait-band angular rate about the instantaneous gravity (a flat
+    // phone's too: the hand pitches it about the body's lateral axis, which tells portrait from
+    // landscape, flat_square_axis)
+    if (level || (tilt_ok_ && have_gyro_ && bout_.placement == Placement::kFlat)) {
       const Eigen::Vector3d w_h = w_hp_out_ - w_hp_out_.dot(tilt_up_) * tilt_up_;
       cov_w_ += w_h * w_h.transpose();
       sum_up_walk_ += tilt_up_;
@@ -301,9 +305,9 @@ void PlacementEstimator::update_forward() {
       prior_rejected_ = cos_line < std::cos(opt_.prior_max_angle_rad);
     }
   }
+  if (bout_.placement == Placement::kFlat && trusted && walking_s_ >= opt_.prior_check_s) flat_axis_ = flat_square_axis();
   if (prior_applies()) {
-    const Eigen::Vector3d prior = bout_.placement == Placement::kFlat ? Eigen::Vector3d(Eigen::Vector3d::UnitY())
-                                                                      : Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
+    const Eigen::Vector3d prior = bout_.placement == Placement::kFlat ? flat_axis_ : Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
     double c = 0.0;
     const double vf = prior.dot(cov_h_ * prior);
     prior_supported_ = var_v_ > 0.0 && vf > 0.0 && prior.dot(corr_) > 0.0;
@@ -325,6 +329,26 @@ void PlacementEstimator::update_forward() {
     bout_.forward_phone = reference_;
     bout_.phase_corr = 0.0;
   }
+}
+
+// A flat phone is held square to the body, in portrait (+Y ahead) or in landscape (+-X ahead):
+// the walking line is the square axis across the dominant horizontal gait rotation (the hand
+// pitching the phone about the body's lateral axis: within 16 deg of +-X on every ILC walk held
+// in portrait, eigenvalue ratio <= 0.26), portrait unless that axis lies nearer +-Y. Landscape's
+// sign (left or right edge ahead: no prior prefers one) is the phase correlation's; the flip
+// test then treats it as the portrait prior. Gyroscope only: the magnetometer's rate misses the
+// turning about the field (ILC without a gyroscope: 3 walks turned to landscape, ETH 51 -> 115 m).
+Eigen::Vector3d PlacementEstimator::flat_square_axis() const {
+  const Eigen::Vector3d portrait = Eigen::Vector3d::UnitY();
+  if (!(opt_.rotation_axis_max_ratio > 0.0) || !(cov_w_.trace() > 0.0)) return portrait;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(cov_w_);  // ascending eigenvalues
+  if (es.info() != Eigen::Success || !(es.eigenvalues()(2) > 0.0) ||
+      es.eigenvalues()(1) > opt_.rotation_axis_max_ratio * es.eigenvalues()(2))
+    return portrait;  // no dominant axis: the prior stands
+  const Eigen::Vector3d axis = es.eigenvectors().col(2);
+  if (std::abs(axis.y()) <= std::abs(axis.x())) return portrait;  // pitched about +-X: portrait
+  return corr_.x() >= 0.0 ? Eigen::Vector3d(Eigen::Vector3d::UnitX()) : Eigen::Vector3d(-Eigen::Vector3d::UnitX());
 }
 
 std::optional<Eigen::Vector3d> PlacementEstimator::rotation_axis_forward() const {

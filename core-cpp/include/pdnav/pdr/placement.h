@@ -12,7 +12,9 @@
 // (corr(a_f(t), a_v(t + tau)) > 0, positive on 42 of the 43 ILC walks; Combettes & Renaudin,
 // "Comparison of misalignment estimation techniques between handheld device and walking
 // directions", IPIN 2015, use the same phase relation). For "other" placements the direction
-// is that lagged correlation vector itself, c = E[a_h(t) a_v(t + tau)] (no axis prior).
+// is that lagged correlation vector itself, c = E[a_h(t) a_v(t + tau)] (no axis prior). A flat
+// phone may be held in landscape (+-X ahead): with a gyroscope its line is the square axis
+// across the hand's dominant pitch axis (flat_square_axis).
 // The vertical/horizontal split of each sample uses the instantaneous gravity direction of a
 // gyro-propagated tilt filter (complementary filter on the gravity vector, Mahony, Hamel,
 // Pflimlin, "Nonlinear complementary filters on the special orthogonal group", IEEE TAC 2008;
@@ -198,6 +200,8 @@ class PlacementEstimator {
   Eigen::Vector3d step_band(const Eigen::Vector3d& lin, double dt_s);
   // the walking direction from the dominant horizontal gait rotation axis (unsigned), if any
   std::optional<Eigen::Vector3d> rotation_axis_forward() const;
+  // a flat phone's walking line: portrait (+Y) or landscape (+-X), from the gait rotation
+  Eigen::Vector3d flat_square_axis() const;
   // one angular rate sample (phone axes, rad/s), from the gyroscope or the magnetometer
   void feed_rate(TimeNs t_ns, const Eigen::Vector3d& rate_radps);
   double flip_threshold() const;
@@ -245,6 +249,7 @@ class PlacementEstimator {
   double walking_s_ = 0.0;
   bool prior_supported_ = false;  // running phase correlation along the prior axis > 0
   bool prior_rejected_ = false;   // the motion's direction is off the prior's line
+  Eigen::Vector3d flat_axis_ = Eigen::Vector3d::UnitY();  // a flat bout's prior axis (flat_square_axis)
   bool bout_levelled_ = false;    // the bout's correlation is split about the tilt filter's gravity
   // tilt filter (gravity direction in phone axes, gyro-propagated)
   Eigen::Vector3d tilt_up_ = Eigen::Vector3d::UnitZ();
