@@ -348,6 +348,9 @@ Eigen::Vector3d PlacementEstimator::flat_square_axis() const {
     return portrait;  // no dominant axis: the prior stands
   const Eigen::Vector3d axis = es.eigenvectors().col(2);
   if (std::abs(axis.y()) <= std::abs(axis.x())) return portrait;  // pitched about +-X: portrait
+  // ... and the forward acceleration must agree (the lagged correlation nearer +-X than +-Y):
+  // two independent cues, so a hand that rolls the phone more than it pitches stays in portrait
+  if (std::abs(corr_.x()) <= std::abs(corr_.y())) return portrait;
   return corr_.x() >= 0.0 ? Eigen::Vector3d(Eigen::Vector3d::UnitX()) : Eigen::Vector3d(-Eigen::Vector3d::UnitX());
 }
 
