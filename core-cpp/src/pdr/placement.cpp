@@ -334,10 +334,9 @@ void PlacementEstimator::update_forward() {
 // A flat phone is held square to the body, in portrait (+Y ahead) or in landscape (+-X ahead):
 // the walking line is the square axis across the dominant horizontal gait rotation (the hand
 // pitching the phone about the body's lateral axis: within 16 deg of +-X on every ILC walk held
-// in portrait, eigenvalue ratio <= 0.26), portrait unless that axis and the lagged correlation
-// both lie nearer +-Y and +-X respectively. Landscape's
-// sign (left or right edge ahead: no prior prefers one) is the phase correlation's; the flip
-// test then treats it as the portrait prior. Gyroscope only: the magnetometer's rate misses the
+// in portrait, eigenvalue ratio <= 0.26), portrait unless that axis lies nearer +-Y and the
+// lagged correlation nearer +-X. Landscape's sign (left or right edge ahead: no prior prefers
+// one) is the phase correlation's; the flip test then treats it as the portrait prior. Gyroscope only: the magnetometer's rate misses the
 // turning about the field (ILC without a gyroscope: 3 walks turned to landscape, ETH 51 -> 115 m).
 Eigen::Vector3d PlacementEstimator::flat_square_axis() const {
   const Eigen::Vector3d portrait = Eigen::Vector3d::UnitY();
