@@ -145,6 +145,10 @@ jlong nav_create(JNIEnv* env, jclass, jstring mode, jdouble lat, jdouble lon, jd
                  jint particles, jstring preset, jlong seed) {
   return guarded<jlong>(env, 0, [&] {
     fusion::NavigatorConfig c;
+    // The app declares no mount: the phone may be anywhere on the walker (a chest mount, a hand,
+    // a pocket), so the placement is estimated from the motion, as `pdnav replay` does; an app
+    // session and its replay on the host then give the same track.
+    c.mount = pdr::Mount::kAuto;
     c.mode = fusion::engine_mode_from_string(to_string(env, mode, "mode"));
     c.start_lat_deg = lat;
     c.start_lon_deg = lon;

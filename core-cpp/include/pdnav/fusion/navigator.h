@@ -145,7 +145,8 @@ struct NavigatorConfig {
   bool user_female = false;
   /// Phone placement: kAuto estimates placement and walking direction from the motion and,
   /// with the height unknown, uses the unknown-walker step length (docs/pdr.md); a declared
-  /// mount overrides both (the default keeps the app's chest mount; `pdnav replay` uses auto).
+  /// mount overrides both (the default is a chest mount, which the reliability tests' simulated
+  /// walkers encode; `pdnav replay` and the app's JNI bridge use auto).
   pdr::Mount mount = pdr::Mount::kChestCameraOut;
   std::string dem_path;                   // project DEM tile (dem-tools), empty = no terrain engine
   std::string graph_path;                 // project walkway graph (dem-tools), empty = no route engine

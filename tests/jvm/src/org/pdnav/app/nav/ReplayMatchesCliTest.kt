@@ -96,6 +96,18 @@ class ReplayMatchesCliTest {
         assertSameTrack(cli, kotlinTrack(log, NavigatorConfig(navPaths = listOf(nav.path)), 3L))
     }
 
+    /** A real walk with every motion sensor (the shared Sensor Logger walk, read from its folder):
+     *  the app's navigator estimates the phone's placement as `pdnav replay` does (a declared
+     *  chest mount in the bridge gave another track), so an app session replays to its own track. */
+    @Test
+    fun sensorLoggerWalkWithMotionSensorsMatchesTheCli() {
+        val walk = TestPaths.sharedDir("walk-ethz-sensorlogger/2023-03-17_15-50-47")
+        // the app's NavigatorConfig states the walker's height (1.75 m unless set): the CLI gets it too
+        val cli = cliTrack(walk, listOf("--seed", "2", "--height", "1.75"), "ethz")
+        assertTrue(cli.size > 500, "the walk's estimates: ${cli.size}")
+        assertSameTrack(cli, kotlinTrack(walk, NavigatorConfig(), 2L))
+    }
+
     @Test
     fun batchSizeDoesNotChangeTheResult() {
         val log = TestPaths.sharedData("gnss-mountainview/pseudoranges_log_2016_08_22_14_45_50.txt")

@@ -17,6 +17,13 @@ object TestPaths {
         return f
     }
 
+    /** A folder of the shared data (a logger's export). */
+    fun sharedDir(rel: String): File {
+        val f = File(prop("pdnav.shared.data"), rel)
+        check(f.isDirectory) { "shared data missing: $f (put ../shared beside the project root)" }
+        return f
+    }
+
     /** A fresh, empty scratch directory for one test. */
     fun scratch(name: String): File {
         val d = File(prop("pdnav.scratch"), name)
