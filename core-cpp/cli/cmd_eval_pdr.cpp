@@ -370,12 +370,6 @@ std::vector<Sample> read_samples(const std::string& path) {
 
 std::vector<Sample> rotated_phone(const std::vector<Sample>& in, const Eigen::AngleAxisd& rot);
 
-/// The walk with a hard iron the phone did not calibrate out (--hard-iron, phone axes, uT): added to
-/// every magnetometer reading, calibrated or not (an uncalibrated reading's stated bias does not
-/// know it), as a phone whose calibration has not converged (Android accuracy 0-1) or a raw iOS
-/// magnetometer records it. The rotation vectors and orientation angles the phone computed from
-/// its own field would carry it too and cannot be recomputed here: they are dropped (the naive
-/// PDR, which reads them, then has no heading); the game rotation vector uses no magnetometer.
 /// "x,y,z" in uT, each finite and within +-1000 (a phone's hard iron is tens of uT); throws
 /// CLI::ValidationError naming what was given.
 std::vector<double> parse_hard_iron(const std::string& text) {
@@ -394,6 +388,12 @@ std::vector<double> parse_hard_iron(const std::string& text) {
   return v;
 }
 
+/// The walk with a hard iron the phone did not calibrate out (--hard-iron, phone axes, uT): added to
+/// every magnetometer reading, calibrated or not (an uncalibrated reading's stated bias does not
+/// know it), as a phone whose calibration has not converged (Android accuracy 0-1) or a raw iOS
+/// magnetometer records it. The rotation vectors and orientation angles the phone computed from
+/// its own field would carry it too and cannot be recomputed here: they are dropped (the naive
+/// PDR, which reads them, then has no heading); the game rotation vector uses no magnetometer.
 std::vector<Sample> with_hard_iron(const std::vector<Sample>& in, const std::vector<double>& b) {
   const Eigen::Vector3d bias(b.at(0), b.at(1), b.at(2));
   std::vector<Sample> out;

@@ -336,17 +336,14 @@ void PlacementEstimator::update_forward() {
 // pitching the phone about the body's lateral axis: within 16 deg of +-X on every ILC walk held
 // in portrait, eigenvalue ratio <= 0.26), portrait unless that axis lies nearer +-Y and the
 // lagged correlation nearer +-X. Landscape's sign (left or right edge ahead: no prior prefers
-// one) is the phase correlation's; the flip test then treats it as the portrait prior. Gyroscope only: the magnetometer's rate misses the
-// turning about the field (ILC without a gyroscope: 3 walks turned to landscape, ETH 51 -> 115 m).
+// one) is the phase correlation's; the flip test then treats it as the portrait prior. Gyroscope
+// only: the magnetometer's rate misses the turning about the field (ILC without a gyroscope: 3
+// walks turned to landscape, ETH 51 -> 115 m).
 Eigen::Vector3d PlacementEstimator::flat_square_axis() const {
   const Eigen::Vector3d portrait = Eigen::Vector3d::UnitY();
-  if (!(opt_.rotation_axis_max_ratio > 0.0) || !(cov_w_.trace() > 0.0)) return portrait;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
-  es.computeDirect(cov_w_);  // ascending eigenvalues
-  if (es.info() != Eigen::Success || !(es.eigenvalues()(2) > 0.0) ||
-      es.eigenvalues()(1) > opt_.rotation_axis_max_ratio * es.eigenvalues()(2))
-    return portrait;  // no dominant axis: the prior stands
-  const Eigen::Vector3d axis = es.eigenvectors().col(2);
+  const std::optional<Eigen::Vector3d> dominant = dominant_rotation_axis();
+  if (!dominant) return portrait;  // no dominant axis: the prior stands
+  const Eigen::Vector3d& axis = *dominant;
   if (std::abs(axis.y()) <= std::abs(axis.x())) return portrait;  // pitched about +-X: portrait
   // ... and the forward acceleration must agree (the lagged correlation nearer +-X than +-Y):
   // two independent cues, so a hand that rolls the phone more than it pitches stays in portrait
@@ -354,16 +351,24 @@ Eigen::Vector3d PlacementEstimator::flat_square_axis() const {
   return corr_.x() >= 0.0 ? Eigen::Vector3d(Eigen::Vector3d::UnitX()) : Eigen::Vector3d(-Eigen::Vector3d::UnitX());
 }
 
-std::optional<Eigen::Vector3d> PlacementEstimator::rotation_axis_forward() const {
-  if (!(opt_.rotation_axis_max_ratio > 0.0) || !bout_levelled_ || !(cov_w_.trace() > 0.0) ||
-      !(sum_up_walk_.norm() > 0.0))
-    return std::nullopt;
+// The gait rotation's dominant horizontal axis (phone axes, unsigned): the principal axis of the
+// walking samples' gait-band angular rate when the second eigenvalue is below
+// rotation_axis_max_ratio of the largest, else none.
+std::optional<Eigen::Vector3d> PlacementEstimator::dominant_rotation_axis() const {
+  if (!(opt_.rotation_axis_max_ratio > 0.0) || !(cov_w_.trace() > 0.0)) return std::nullopt;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
   es.computeDirect(cov_w_);  // closed form (called per walking sample); ascending eigenvalues
   if (es.info() != Eigen::Success || !(es.eigenvalues()(2) > 0.0) ||
       es.eigenvalues()(1) > opt_.rotation_axis_max_ratio * es.eigenvalues()(2))
     return std::nullopt;
-  const Eigen::Vector3d f = sum_up_walk_.normalized().cross(es.eigenvectors().col(2));
+  return Eigen::Vector3d(es.eigenvectors().col(2));
+}
+
+std::optional<Eigen::Vector3d> PlacementEstimator::rotation_axis_forward() const {
+  if (!bout_levelled_ || !(sum_up_walk_.norm() > 0.0)) return std::nullopt;
+  const std::optional<Eigen::Vector3d> axis = dominant_rotation_axis();
+  if (!axis) return std::nullopt;
+  const Eigen::Vector3d f = sum_up_walk_.normalized().cross(*axis);
   if (f.norm() < 0.5) return std::nullopt;  // (the axis is horizontal by construction)
   return Eigen::Vector3d(f.normalized());
 }

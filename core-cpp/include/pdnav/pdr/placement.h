@@ -202,6 +202,8 @@ class PlacementEstimator {
   std::optional<Eigen::Vector3d> rotation_axis_forward() const;
   // a flat phone's walking line: portrait (+Y) or landscape (+-X), from the gait rotation
   Eigen::Vector3d flat_square_axis() const;
+  // the gait rotation's dominant horizontal axis (rotation_axis_max_ratio), if any
+  std::optional<Eigen::Vector3d> dominant_rotation_axis() const;
   // one angular rate sample (phone axes, rad/s), from the gyroscope or the magnetometer
   void feed_rate(TimeNs t_ns, const Eigen::Vector3d& rate_radps);
   double flip_threshold() const;
