@@ -50,6 +50,7 @@
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/phonesim/handling.h"
 #include "pdnav/phonesim/sample_rate.h"
+#include "support/eval_support.h"
 #include "support/output_file.h"
 #include "support/replay_support.h"
 
@@ -373,19 +374,10 @@ std::vector<Sample> rotated_phone(const std::vector<Sample>& in, const Eigen::An
 /// "x,y,z" in uT, each finite and within +-1000 (a phone's hard iron is tens of uT); throws
 /// CLI::ValidationError naming what was given.
 std::vector<double> parse_hard_iron(const std::string& text) {
-  std::vector<double> v;
-  std::stringstream in(text);
-  std::string part;
-  bool ok = true;
-  while (ok && std::getline(in, part, ',')) {
-    char* end = nullptr;
-    const double x = std::strtod(part.c_str(), &end);
-    ok = !part.empty() && end == part.c_str() + part.size() && std::isfinite(x) && std::abs(x) <= 1000.0;
-    v.push_back(x);
-  }
-  if (!ok || v.size() != 3)
+  const auto v = parse_number_list(text);
+  if (!v || v->size() != 3 || std::any_of(v->begin(), v->end(), [](double x) { return std::abs(x) > 1000.0; }))
     throw CLI::ValidationError("expected x,y,z in uT (three numbers within +-1000), got '" + text + "'");
-  return v;
+  return *v;
 }
 
 /// The walk with a hard iron the phone did not calibrate out (--hard-iron, phone axes, uT): added to

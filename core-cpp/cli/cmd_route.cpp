@@ -17,6 +17,7 @@
 
 #include "pdnav/route/router.h"
 #include "pdnav/route/walk_graph.h"
+#include "support/eval_support.h"
 
 namespace pdnav::cli {
 namespace {
@@ -32,21 +33,11 @@ struct RouteArgs {
 
 /// "LAT,LON" in degrees; anything else is an error naming the option.
 std::pair<double, double> parse_lat_lon(const std::string& text, const char* what) {
-  const auto comma = text.find(',');
-  auto num = [&](const std::string& s) {
-    const char* b = s.c_str();
-    char* end = nullptr;
-    const double v = std::strtod(b, &end);
-    if (s.empty() || end != b + s.size() || !std::isfinite(v)) {
-      throw std::runtime_error(std::string(what) + ": expected LAT,LON in degrees, got '" + text + "'");
-    }
-    return v;
-  };
-  if (comma == std::string::npos) {
+  const auto v = parse_number_list(text);
+  if (!v || v->size() != 2) {
     throw std::runtime_error(std::string(what) + ": expected LAT,LON in degrees, got '" + text + "'");
   }
-  const double lat = num(text.substr(0, comma));
-  const double lon = num(text.substr(comma + 1));
+  const double lat = (*v)[0], lon = (*v)[1];
   if (std::fabs(lat) > 90.0 || std::fabs(lon) > 180.0) {
     throw std::runtime_error(std::string(what) + ": latitude must be within +-90 and longitude +-180, got '" + text + "'");
   }

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 namespace pdnav::cli {
@@ -21,6 +23,20 @@ double median_of_finite(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::optional<std::vector<double>> parse_number_list(const std::string& text) {
+  std::vector<double> out;
+  std::stringstream in(text);
+  std::string part;
+  while (std::getline(in, part, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(part.c_str(), &end);
+    if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(v)) return std::nullopt;
+    out.push_back(v);
+  }
+  if (out.empty() || (!text.empty() && text.back() == ',')) return std::nullopt;  // "" or "1,2,"
+  return out;
 }
 
 void add_fusion_model_option(CLI::App* c, std::string& model) {

@@ -1,6 +1,7 @@
-// Helpers shared by the evaluation commands (eval-fusion, eval-outage): number text for the
-// printed tables, the median of a figure over walks, and the --fusion-model option.
+// Helpers shared by the commands: number text for the printed tables, the median of a figure
+// over walks, the --fusion-model option, and option values given as lists of numbers.
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,10 @@ std::string fixed_or(double v, int decimals, const char* missing);
 
 /// Median of the finite values; NaN when there are none.
 double median_of_finite(std::vector<double> v);
+
+/// "a,b,c": comma-separated decimal numbers, each finite, nothing else around them; nullopt when
+/// any part is not one (the caller names the option and what it expected).
+std::optional<std::vector<double>> parse_number_list(const std::string& text);
 
 /// --fusion-model: the fused covariance model, "issue28" (default) or "issue14" (before issue 28).
 void add_fusion_model_option(CLI::App* c, std::string& model);

@@ -563,6 +563,12 @@ void Pdr::feed(const MagSample& s) {
     qsf_.reset();
     compass_bias_ut_ = magcal_.bias_ut();
   }
+  if (!rv_fresh && (magcal_.bias_ut() - drift_bias_ut_).norm() >= opt_.magcal.drift_restart_change_ut) {
+    // a new hard iron (its first activation included): the compass readings before it measured
+    // another offset, and a line through both would take the calibration's step for gyro drift
+    fusion_.restart_drift();
+    drift_bias_ut_ = magcal_.bias_ut();
+  }
   if (!tracker_.has_gravity()) return;
   const auto compass =
       compass_heading_rad(field_ut, tracker_.up_phone(), reference_axis(), opt_.heading.min_horizontal);

@@ -101,6 +101,9 @@ class HeadingFusion {
   /// One absolute heading (magnetic, of the reference axis) at gyro yaw yaw_rad (left +).
   void add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, double weight, bool gyro_live);
   void reset();
+  /// Forgets the drift fit only (the offset stays): the readings it was learned from measured
+  /// another offset (the magnetometer's calibration changed).
+  void restart_drift() { trusted_ = LineSums{}; }
   bool valid() const { return weight_ > 0.0; }
   /// Magnetic heading of the reference axis at gyro yaw yaw_rad and time t_ns.
   double heading_mag_rad(double yaw_rad, TimeNs t_ns) const;

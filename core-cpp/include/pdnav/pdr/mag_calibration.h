@@ -94,6 +94,13 @@ struct MagCalibrationOptions {
   // Off by default: at 3 uT with the gyro-aided fit the ETH walk's DR gains (48.0 -> 46.0 m) but
   // TYREX with compass headings loses (imu 1.62 -> 1.72 m, at 50 Hz 1.85 -> 2.13; docs/results.md).
   double restart_change_ut = 0.0;
+  // Pdr: a bias that moved this far from the one the heading fusion's gyro drift was learned with
+  // (zero before the first activation) restarts the drift fit only: readings with another hard
+  // iron measure another offset, and a line through both reads the calibration's step as drift
+  // (ETH walk with a 44 uT hard iron: 0.3 deg/s at the first step, 0.7 a minute on, its segments
+  // 13-28 deg off). 10 uT: up to 30 deg across a 20 uT horizontal field, where the converging bias
+  // moves by 1-7 uT (kept: the drift learned with it).
+  double drift_restart_change_ut = 10.0;
 };
 
 /// Streaming hard-iron sphere fit. Deterministic; time as int64 ns.
