@@ -376,6 +376,53 @@ TEST(PdrHeadingFusion, DisturbedReadingsBarelyMoveTheGyroHeading) {
   EXPECT_GT(std::abs(wrap_pi(trusting.heading_mag_rad(0.0, 1500 * 20000000LL) - 30 * kDegToRad)), 10 * kDegToRad);
 }
 
+TEST(PdrHeadingFusion, AFieldWhoseHorizontalPartIsOffTheWmmSaysSoInTheSigma) {
+  const geo::Geodetic where = geo::Geodetic::from_deg(47.4, 8.5, 0);  // Zurich: H ~ 21.6 uT of ~48
+  const geo::MagneticField f = geo::wmm_field(geo::WmmModel::wmm2025(), where, 2025.5);
+  const double h_ut = f.h_nt * 1e-3, z_ut = f.z_nt * 1e-3;
+  const Eigen::Vector3d up(0, 0, 1);
+  const Eigen::Vector3d good(0, h_ut, -z_ut);                 // flat phone, +Y north
+  const Eigen::Vector3d vertical_off(0, h_ut, -z_ut + 20.0);  // a vertical hard iron: no heading error
+  const Eigen::Vector3d half(0, 1.5 * h_ut, -z_ut);           // the horizontal field 50 % too strong
+  const Eigen::Vector3d hard_iron(60.0, h_ut, -z_ut);         // a 60 uT hard iron across the field
+  HeadingFusion ref;
+  ref.set_reference_field(f.f_nt * 1e-3, f.inclination_rad);
+  EXPECT_NEAR(ref.field_deflection_sigma_rad(good, up), 0.0, 1e-9);
+  EXPECT_NEAR(ref.field_deflection_sigma_rad(vertical_off, up), 0.0, 1e-9);
+  EXPECT_NEAR(ref.field_deflection_sigma_rad(half, up), 0.5 / std::sqrt(2.0), 1e-9);
+  EXPECT_NEAR(ref.field_deflection_sigma_rad(hard_iron, up), (std::hypot(60.0, h_ut) - h_ut) / (std::sqrt(2.0) * h_ut), 1e-9);
+  EXPECT_NEAR(ref.field_deflection_sigma_rad(4.0 * hard_iron, up), kPi / std::sqrt(3.0), 1e-12);  // at most uniform
+  EXPECT_EQ(HeadingFusion().field_deflection_sigma_rad(half, up), 0.0);  // no reference: unknown
+  // 60 s of readings of each field, disturbed ones at their low weight as the Pdr gives them:
+  // the clean field's sigma is the readings' noise averaged down (15 deg over ~8 independent
+  // ones); a field off the WMM is not averaged out (a disturbance is systematic)
+  const auto sigma_after = [&](const Eigen::Vector3d& field) {
+    HeadingFusion h;
+    h.set_reference_field(f.f_nt * 1e-3, f.inclination_rad);
+    for (int i = 0; i < 3000; ++i)
+      h.add(i * 20'000'000LL, 30 * kDegToRad, 0.0, h.field_weight(field, up), true,
+            h.field_deflection_sigma_rad(field, up));
+    return h.sigma_rad() / kDegToRad;
+  };
+  EXPECT_LT(sigma_after(good), 6.0);
+  EXPECT_LT(sigma_after(vertical_off), 16.0);  // refused by the magnitude test: weight, not sigma
+  EXPECT_GT(sigma_after(half), 0.5 / std::sqrt(2.0) / kDegToRad);
+  EXPECT_GT(sigma_after(hard_iron), 60.0);
+}
+
+TEST(PdrHeadingFusion, RestartingTheDriftForgetsTheSlopeButNotTheOffset) {
+  HeadingFusion h;
+  // 60 s of readings whose offset ramps by 0.5 deg/s (readings taken with another hard iron,
+  // then the calibration's step read as drift)
+  for (int i = 0; i < 3000; ++i) h.add(i * 20'000'000LL, (40.0 + 0.5 * i * 0.02) * kDegToRad, 0.0, 1.0, true);
+  EXPECT_GT(h.drift_radps() / kDegToRad, 0.2);
+  const double before = h.heading_mag_rad(0.0, 3000 * 20'000'000LL);
+  h.restart_drift();
+  EXPECT_EQ(h.drift_radps(), 0.0);
+  EXPECT_TRUE(h.valid());
+  EXPECT_LT(std::abs(wrap_pi(h.heading_mag_rad(0.0, 3000 * 20'000'000LL) - before)), 30 * kDegToRad);
+}
+
 /// The drift HeadingFusion estimates from 30 s of 50 Hz readings whose offset c (heading + gyro
 /// yaw) is a ramp of drift_dps plus a field disturbance: a smooth random process with the
 /// given std and correlation time (first-order Gauss-Markov, seeded), as walking through a

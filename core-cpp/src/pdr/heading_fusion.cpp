@@ -29,6 +29,15 @@ double HeadingFusion::field_weight(const Eigen::Vector3d& field_ut, const Eigen:
   return ok ? 1.0 : opt_.disturbed_weight;
 }
 
+double HeadingFusion::field_deflection_sigma_rad(const Eigen::Vector3d& field_ut, const Eigen::Vector3d& up_phone) const {
+  if (!std::isfinite(ref_total_ut_) || !field_ut.allFinite() || !(up_phone.norm() > 0.0)) return 0.0;
+  const double down = -field_ut.dot(up_phone.normalized());
+  const double horizontal = std::sqrt(std::max(0.0, field_ut.squaredNorm() - down * down));
+  const double ref_horizontal = ref_total_ut_ * std::cos(ref_dip_rad_);
+  if (!(ref_horizontal > 0.0)) return 0.0;
+  return std::min(kPi / std::sqrt(3.0), std::abs(horizontal - ref_horizontal) / (std::sqrt(2.0) * ref_horizontal));
+}
+
 void HeadingFusion::LineSums::shift_and_decay(double dt_s, double decay) {
   // re-anchor at the new reading (tau' = tau - dt), then forget
   s2 = s2 - 2.0 * dt_s * s1 + dt_s * dt_s * s0;
@@ -37,7 +46,8 @@ void HeadingFusion::LineSums::shift_and_decay(double dt_s, double decay) {
   s0 *= decay, s1 *= decay, s2 *= decay, y0 *= decay, y1 *= decay, yy *= decay;
 }
 
-void HeadingFusion::add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, double weight, bool gyro_live) {
+void HeadingFusion::add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, double weight, bool gyro_live,
+                        double deflection_sigma_rad) {
   if (!std::isfinite(heading_mag_rad) || !std::isfinite(yaw_rad) || !(weight > 0.0)) return;
   // heading = c - yaw (yaw is counter-clockwise, heading clockwise): c is constant for a gyro
   // without drift, whatever the path.
@@ -51,6 +61,7 @@ void HeadingFusion::add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, dou
     const double decay = std::exp(-dt_s / (gyro_live ? opt_.tau_s : opt_.no_gyro_tau_s));
     all_.shift_and_decay(dt_s, decay);
     circ_ *= decay;
+    deflection2_ *= decay;
     trusted_.shift_and_decay(dt_s, gyro_live ? std::exp(-dt_s / opt_.drift_tau_s) : decay);
     weight_s_ = weight_s_ * decay + weight * std::min(1.0, dt_s);
   }
@@ -60,6 +71,7 @@ void HeadingFusion::add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, dou
   const double pred = all_.s0 > 0.0 ? (all_.y0 - drift_radps() * all_.s1) / all_.s0 : 0.0;
   const double y = pred + wrap_pi(c - anchor_rad_ - pred);
   all_.add(weight, y);
+  if (std::isfinite(deflection_sigma_rad)) deflection2_ += weight * deflection_sigma_rad * deflection_sigma_rad;
   circ_ += weight * Eigen::Vector2d(std::cos(c), std::sin(c));
   last_c_rad_ = c;
   if (weight >= 1.0) trusted_.add(weight, y);
@@ -87,7 +99,7 @@ double HeadingFusion::drift_radps() const {
 void HeadingFusion::reset() {
   all_ = LineSums{};
   trusted_ = LineSums{};
-  weight_ = weight_s_ = 0.0;
+  weight_ = weight_s_ = deflection2_ = 0.0;
   circ_.setZero();
   have_last_ = false;
 }
@@ -103,7 +115,9 @@ double HeadingFusion::heading_mag_rad(double yaw_rad, TimeNs t_ns) const {
 double HeadingFusion::sigma_rad() const {
   if (!valid()) return kPi;
   const double n_independent = std::max(1.0, weight_s_ / opt_.decorrelation_s);
-  return std::clamp(opt_.base_sigma_rad / std::sqrt(n_independent), opt_.min_sigma_rad, kPi);
+  const double base = opt_.base_sigma_rad / std::sqrt(n_independent);
+  const double deflection2 = all_.s0 > 0.0 ? deflection2_ / all_.s0 : 0.0;  // the readings' fields' own
+  return std::clamp(std::sqrt(base * base + deflection2), opt_.min_sigma_rad, kPi);
 }
 
 void QuasiStaticField::add(TimeNs t_ns, double offset_rad, double field_ut) {

@@ -125,7 +125,8 @@ HeadingSource Pdr::heading_source(TimeNs t_ns) const {
   return w >= opt_.trusted_source_weight ? abs_kind_ : HeadingSource::kGyro;
 }
 
-void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight, HeadingSource kind) {
+void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight, HeadingSource kind,
+                           double deflection_sigma_rad) {
   if (handling_reset_) return;  // handled: no offset is learned (track_handling)
   // decayed mean of the readings' weights (source report only)
   if (kind != abs_kind_ || abs_weight_ns_ < 0) {
@@ -136,7 +137,8 @@ void Pdr::absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight, H
     abs_weight_mean_ = a * abs_weight_mean_ + (1.0 - a) * weight;
   }
   abs_weight_ns_ = t_ns;
-  fusion_.add(t_ns, heading_mag_rad, tracker_.axis_yaw_rad(), weight, gyro_live(t_ns) && tracker_.has_gravity());
+  fusion_.add(t_ns, heading_mag_rad, tracker_.axis_yaw_rad(), weight, gyro_live(t_ns) && tracker_.has_gravity(),
+              deflection_sigma_rad);
   have_heading_ = true;
   ref_t_ns_ = t_ns;
 }
@@ -583,7 +585,7 @@ void Pdr::feed(const MagSample& s) {
   if (!compass) return;
   absolute_heading(s.t_ns, *compass,
                    qsf_weight() * mag_accuracy_weight_ * fusion_.field_weight(field_ut, tracker_.up_phone()),
-                   HeadingSource::kCompass);
+                   HeadingSource::kCompass, fusion_.field_deflection_sigma_rad(field_ut, tracker_.up_phone()));
 }
 
 void Pdr::feed(const SensorAccuracySample& s) {
@@ -618,7 +620,8 @@ void Pdr::feed(const RotationVectorSample& s) {
   // nominal reading, never above it
   if (std::isfinite(s.heading_accuracy_rad) && s.heading_accuracy_rad > 0.0)
     w *= std::clamp(std::pow(opt_.fusion.base_sigma_rad / s.heading_accuracy_rad, 2), opt_.fusion.disturbed_weight, 1.0);
-  absolute_heading(s.t_ns, *h, w, HeadingSource::kRotationVector);
+  absolute_heading(s.t_ns, *h, w, HeadingSource::kRotationVector,
+                   mag_fresh && tracker_.has_gravity() ? fusion_.field_deflection_sigma_rad(last_field_ut_, tracker_.up_phone()) : 0.0);
 }
 
 void Pdr::feed(const StepDetectorSample& s) {

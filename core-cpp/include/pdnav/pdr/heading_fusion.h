@@ -98,8 +98,17 @@ class HeadingFusion {
   double field_weight(const Eigen::Vector3d& field_ut, const Eigen::Vector3d& up_phone) const;
   /// Weight multiplier for Android's magnetometer accuracy level (options.accuracy_weight).
   double accuracy_weight(int android_accuracy) const;
-  /// One absolute heading (magnetic, of the reference axis) at gyro yaw yaw_rad (left +).
-  void add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, double weight, bool gyro_live);
+  /// The heading error a reading's field may carry (rad, 1-sigma): its horizontal part differs
+  /// from the WMM's horizontal intensity H by at least q = | |B_h| - H |, and a horizontal
+  /// perturbation of size q deflects the heading by about (q / H) sin(phi), phi its unknown
+  /// direction: rms q / (sqrt 2 H), at most a uniform heading's (pi / sqrt 3). The vertical
+  /// part turns no heading. 0 without a reference field.
+  double field_deflection_sigma_rad(const Eigen::Vector3d& field_ut, const Eigen::Vector3d& up_phone) const;
+  /// One absolute heading (magnetic, of the reference axis) at gyro yaw yaw_rad (left +);
+  /// deflection_sigma_rad: the field's own possible error (field_deflection_sigma_rad), part of
+  /// sigma_rad() as the readings' weighted mean square.
+  void add(TimeNs t_ns, double heading_mag_rad, double yaw_rad, double weight, bool gyro_live,
+           double deflection_sigma_rad = 0.0);
   void reset();
   /// Forgets the drift fit only (the offset stays): the readings it was learned from measured
   /// another offset (the magnetometer's calibration changed).
@@ -130,6 +139,7 @@ class HeadingFusion {
   Eigen::Vector2d circ_ = Eigen::Vector2d::Zero();  // decayed sum of w (cos c, sin c)
   double last_c_rad_ = 0.0;                         // the latest reading's offset
   double weight_s_ = 0.0;                          // decayed sum of w dt (information, seconds)
+  double deflection2_ = 0.0;                       // decayed sum of w deflection_sigma^2
   bool have_last_ = false;
   TimeNs last_ns_ = 0;
   std::int64_t accepted_ = 0, disturbed_ = 0;

@@ -293,7 +293,8 @@ class Pdr {
   bool android_active(TimeNs t_ns) const;
   void trim_consistency(TimeNs t_ns);
   Eigen::Vector3d reference_axis() const;
-  void absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight, HeadingSource kind);
+  void absolute_heading(TimeNs t_ns, double heading_mag_rad, double weight, HeadingSource kind,
+                        double deflection_sigma_rad);
   /// A gyroscope sample arrived within the turn tracker's gap (heading.turn.gap_reset_s) of t_ns.
   bool gyro_live(TimeNs t_ns) const;
   HeadingSource heading_source(TimeNs t_ns) const;
