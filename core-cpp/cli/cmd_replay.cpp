@@ -107,14 +107,6 @@ int run_replay(const ReplayArgs& a) {
   io::SampleSource& reader = *source;
   const fusion::NavigatorConfig config = make_config(a);
   fusion::Navigator nav(config, a.seed);
-  // A PDR twin with the Navigator's placement options, for the summary's placements/distance.
-  pdr::PdrOptions twin_opt;
-  twin_opt.heading.mount = config.mount;
-  twin_opt.source = pdr::StepSource::kAuto;
-  twin_opt.length = std::isfinite(config.user_height_m) ? pdr::StepLengthModel::apt_male(config.user_height_m)
-                    : config.mount == pdr::Mount::kAuto ? pdr::StepLengthModel::unknown_walker()
-                                                        : pdr::StepLengthModel::apt_male(fusion::kDefaultUserHeightM);
-  pdr::Pdr twin(twin_opt);
   TimeNs t0_ns = -1;
   ReplayRecorder rec;
   ProgressBar progress(a.quiet ? nullptr : &std::cerr, "replay");
@@ -129,10 +121,7 @@ int run_replay(const ReplayArgs& a) {
                         std::is_same_v<T, RotationVectorSample> || std::is_same_v<T, StepDetectorSample> ||
                         std::is_same_v<T, UncalAccelSample> || std::is_same_v<T, UncalGyroSample> ||
                         std::is_same_v<T, UncalMagSample>) {
-            if (t0_ns < 0) t0_ns = x.t_ns;
-            twin.feed(x);
-            (void)twin.take_steps();
-            (void)twin.take_turns();
+            if (t0_ns < 0) t0_ns = x.t_ns;  // the summary's times count from the first motion sample
           }
         },
         s);
@@ -143,8 +132,6 @@ int run_replay(const ReplayArgs& a) {
     progress.update(reader.progress());
   }
   nav.finish();  // a walk shorter than the bout gate is still reported
-  twin.finish();
-  (void)twin.take_steps();
   for (const Estimate& e : nav.take_step_estimates()) rec.observe_estimate(e);
   rec.observe_estimate(nav.estimate());
   progress.done();
@@ -185,7 +172,7 @@ int run_replay(const ReplayArgs& a) {
                           {"particles", to->particles},
                           {"walker_scale_sigma", to->step_scale_sigma},
                           {"walk_grade_sigma", to->stride_walk_grade_sigma}};
-  summary["pdr"] = pdr_summary_json(twin, nav.output(0).steps, std::max<TimeNs>(0, t0_ns));
+  summary["pdr"] = pdr_summary_json(nav.pdr(), nav.output(0).steps, std::max<TimeNs>(0, t0_ns));
   const fusion::NavigatorOutput o = nav.output(0);  // the PDR declination: model and any warning (#19.2)
   summary["declination"] = {{"known", o.declination_known}, {"deg", rad_to_deg(o.declination.declination_rad)},
                             {"model", o.declination.model}, {"warning", o.declination.warning}};

@@ -926,6 +926,8 @@ NavigatorOutput Navigator::output(std::size_t max_particles) const {
 
 std::vector<ModeChange> Navigator::mode_changes() const { return {impl_->changes.begin(), impl_->changes.end()}; }
 
+const pdr::Pdr& Navigator::pdr() const { return impl_->pdr; }
+
 const terrain::TerrainOptions* Navigator::terrain_options() const {
   return impl_->terrain ? &impl_->terrain->options() : nullptr;
 }

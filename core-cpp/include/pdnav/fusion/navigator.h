@@ -15,6 +15,7 @@
 #include "pdnav/geo/estimate.h"
 #include "pdnav/geo/samples.h"
 #include "pdnav/pdr/heading.h"
+#include "pdnav/pdr/pdr.h"
 #include "pdnav/geo/wmm.h"
 
 namespace pdnav::terrain { class Dem; struct TerrainOptions; }
@@ -221,6 +222,9 @@ class Navigator {
   /// The terrain engine's options as configured here (the preset, particles, and the walker-scale
   /// prior shared with the fused filter); nullptr without a terrain engine.
   const terrain::TerrainOptions* terrain_options() const;
+  /// The PDR as this Navigator runs it (its location, the log's height, its placement bouts,
+  /// heading sources and hard-iron calibration), for reports; its steps are taken here.
+  const pdr::Pdr& pdr() const;
   /// Fusion counters (GNSS rejected by the gate, forced corrections, re-anchors, ...).
   std::vector<std::pair<std::string, std::int64_t>> fusion_counts() const;
   /// Names of two of them: the route engine's step-scale samples used / refused by the gate.
