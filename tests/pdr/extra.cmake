@@ -153,6 +153,14 @@ add_test(NAME pdr_cli_eval_pdr_all
                  --out "${_pdr_tyrex_out}" --pdnav $<TARGET_FILE:pdnav> --data "${PDNAV_SHARED_DATA_DIR}")
 set_tests_properties(pdr_cli_eval_pdr_all PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
                      PASS_REGULAR_EXPRESSION "running pocket/none +1 .*texting/none +1 .*summary tyrex sensors=all: walks 2 median_mean_error_m [0-7]\\.[0-9]+ median_rms_pct [0-9.]+ .* median_step_error_pct ([0-9]|[12][0-9])\\.[0-9] .* beats_naive [0-2] beats_still [0-2] naive_median_mean_error_m [0-9.]+ still_median_mean_error_m [0-9.]+ median_coverage_68 (0\\.[0-9]+|1\\.00) pooled_coverage_68 [01]\\.[0-9]+\n.*summary tyrex-hardiron sensors=all: walks 2 median_mean_error_m [0-9]\\.[0-9]+ .*summary outdoor sensors=all: walks 1 median_mean_error_m [2-6][0-9]\\.[0-9]+ median_rms_pct [0-9.]+ median_seg_heading_abs_deg [0-9]\\.[0-9] .* median_length_ratio 0\\.[6-9][0-9]+ .* naive_median_mean_error_m - still_median_mean_error_m 1[0-9][0-9]\\.[0-9]+ median_coverage_68 (0\\.[0-9]+|1\\.00) pooled_coverage_68 [01]\\.[0-9]+\n.*summary outdoor-hardiron sensors=all: walks 1 median_mean_error_m [0-9]+\\.[0-9]+ median_rms_pct [0-9.]+ median_seg_heading_abs_deg [0-7]\\.[0-9] .*summary oxford: walks 6 mean_step_error_pct 0\\.[0-9]+ worst_step_error_pct [0-2]\\.[0-9]+ ")
+# eval-pdr-all --compare: the same two TYREX walks evaluated twice (the second run against the
+# first's per-walk JSON) move nothing (deterministic), and a folder that is not a run is refused.
+add_test(NAME pdr_cli_eval_pdr_all_compare
+         COMMAND sh -c "d=\"$2\"; rm -rf \"$d\"; mkdir -p \"$d/a\" \"$d/b\" || exit 1; ln -s \"$1/logs\" \"$d/a/logs\"; ln -s \"$1/logs\" \"$d/b/logs\"; for r in a b; do c=''; [ $r = b ] && c=\"--compare $d/a\"; /usr/bin/python3 \"$0\" --sets tyrex --no-convert --rates '' --hard-iron '' --out \"$d/$r\" --pdnav \"$3\" $c > \"$d/$r.txt\" 2>&1 || exit 1; done; grep '^compare' \"$d/b.txt\"; /usr/bin/python3 \"$0\" --sets tyrex --no-convert --out \"$d/b\" --pdnav \"$3\" --compare \"$d/none\" 2>&1 | tail -1"
+                 "${PROJECT_SOURCE_DIR}/tools/eval-pdr-all" "${_pdr_tyrex_out}" "${PROJECT_BINARY_DIR}/test-scratch/pdr-all-compare"
+                 $<TARGET_FILE:pdnav>)
+set_tests_properties(pdr_cli_eval_pdr_all_compare PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
+                     PASS_REGULAR_EXPRESSION "compare tyrex sensors=all: identical\ncompare: 0 of 1 summaries moved against [^\n]*/a\n[^\n]*--compare: [^\n]*/none: not a folder")
 # eval-pdr --rate: the 200 Hz TYREX texting walk block-averaged to 50 Hz keeps a quarter of its
 # accelerometer lines (written with --write-logs, 24-26 %), and a rate at or above the
 # recording's leaves the walk as recorded (the per-walk line identical to the one without it).
