@@ -180,18 +180,18 @@ void Pdr::feed(const UncalGyroSample& s) {
       drift = gyro_rest_.bias_radps();
       drift_known = gyro_rest_.known();
     }
-    // a raw rate integrates its drift (degrees per second) into the hard-iron fit's attitude,
-    // which its gyro-bias state (a residual of tenths of a degree per second) cannot absorb
-    magcal_gyro_ok_ = drift_known;
     if (drift_known) {
       const bool moved = magcal_drift_set_ && (drift - magcal_drift_radps_).norm() > opt_.magcal.prior_gyro_bias_radps;
       if (moved) magcal_.restart_pairs();
       if (moved || !magcal_drift_set_) magcal_drift_radps_ = drift, magcal_drift_set_ = true;
     }
   }
+  // a raw rate integrates its drift (degrees per second) into the hard-iron fit's attitude, which
+  // its gyro-bias state (a residual of tenths of a degree per second) cannot absorb: until the
+  // drift is known the rate gives the fit no attitude
   feed_uncal(GyroSample{s.t_ns, s.utc_ms, s.rate_radps - drift}, sensors_.uncal_gyro, sensors_.gyro,
-             last_cal_gyro_ns_, first_uncal_gyro_ns_);
-  magcal_gyro_ok_ = true;
+             last_cal_gyro_ns_, first_uncal_gyro_ns_,
+             [this, drift_known](const GyroSample& g) { feed_gyro(g, drift_known); });
 }
 
 void Pdr::feed(const UncalMagSample& s) {
@@ -526,11 +526,13 @@ void Pdr::finish() {
   flush_undecided(latest_ns_, true);
 }
 
-void Pdr::feed(const GyroSample& s) {
+void Pdr::feed(const GyroSample& s) { feed_gyro(s, true); }
+
+void Pdr::feed_gyro(const GyroSample& s, bool attitude_for_magcal) {
   ++sensors_.gyro;
   last_cal_gyro_ns_ = s.t_ns;
   tracker_.feed(s);
-  if (magcal_gyro_ok_) magcal_.add_gyro(s.t_ns, s.rate_radps);  // the gyro-aided hard-iron fit's attitude
+  if (attitude_for_magcal) magcal_.add_gyro(s.t_ns, s.rate_radps);  // the gyro-aided hard-iron fit's attitude
   placement_.feed(s);  // the tilt filter levels the walking-direction correlation
   classifier_.feed(s);
   detector_.feed(s);   // the stride test reads the swing from the angular rate

@@ -321,21 +321,29 @@ class Pdr {
   template <class Calibrated>
   void feed_uncal(const Calibrated& bias_removed, std::int64_t& uncal_count, std::int64_t& cal_count,
                   TimeNs& last_cal_ns, TimeNs& first_uncal_ns) {
+    feed_uncal(bias_removed, uncal_count, cal_count, last_cal_ns, first_uncal_ns,
+               [this](const Calibrated& c) { feed(c); });
+  }
+  /// ... through `feed_calibrated` (a feed with more to say, e.g. feed_gyro's attitude flag).
+  template <class Calibrated, class Feed>
+  void feed_uncal(const Calibrated& bias_removed, std::int64_t& uncal_count, std::int64_t& cal_count,
+                  TimeNs& last_cal_ns, TimeNs& first_uncal_ns, Feed&& feed_calibrated) {
     if (!uncal_allowed(bias_removed.t_ns, last_cal_ns, first_uncal_ns)) return;
     ++uncal_count;
     --cal_count;
     const TimeNs keep = last_cal_ns;
-    feed(bias_removed);
+    feed_calibrated(bias_removed);
     last_cal_ns = keep;
   }
+  /// A gyroscope sample; attitude_for_magcal: its rate is the gyro-aided hard-iron fit's attitude
+  /// (false for a raw rate whose drift is not known yet).
+  void feed_gyro(const GyroSample& s, bool attitude_for_magcal);
 
   PdrOptions opt_;
   GyroBiasAtRest gyro_rest_;
   bool gyro_rest_used_ = false;
-  // the hard-iron fit's gyro attitude (mag_calibration.h): an uncalibrated gyro whose drift is
-  // not known yet gives none; a drift correction that moved by more than the fit's gyro-bias
-  // prior since the pairs began restarts them
-  bool magcal_gyro_ok_ = true;
+  // the hard-iron fit's gyro attitude (mag_calibration.h): a drift correction that moved by more
+  // than the fit's gyro-bias prior since the pairs began restarts them
   bool magcal_drift_set_ = false;
   Eigen::Vector3d magcal_drift_radps_ = Eigen::Vector3d::Zero();
   StepDetector detector_;
