@@ -560,18 +560,15 @@ void Pdr::feed(const MagSample& s) {
     track_handling();
   }
   const bool rv_fresh = have_rv_ && ns_to_s(s.t_ns - last_rv_ns_) <= opt_.heading.rv_max_age_s;
-  if (opt_.magcal.restart_change_ut > 0.0 && !rv_fresh &&
-      (magcal_.bias_ut() - compass_bias_ut_).norm() >= opt_.magcal.restart_change_ut) {
+  if (!rv_fresh && hard_iron_moved(compass_bias_ut_, opt_.magcal.restart_change_ut)) {
     // the compass offset was learned from readings with another bias: it restarts from these
     fusion_.reset();
     qsf_.reset();
-    compass_bias_ut_ = magcal_.bias_ut();
   }
-  if (!rv_fresh && (magcal_.bias_ut() - drift_bias_ut_).norm() >= opt_.magcal.drift_restart_change_ut) {
+  if (!rv_fresh && hard_iron_moved(drift_bias_ut_, opt_.magcal.drift_restart_change_ut)) {
     // a new hard iron (its first activation included): the compass readings before it measured
     // another offset, and a line through both would take the calibration's step for gyro drift
     fusion_.restart_drift();
-    drift_bias_ut_ = magcal_.bias_ut();
   }
   if (!tracker_.has_gravity()) return;
   const auto compass =
@@ -583,11 +580,17 @@ void Pdr::feed(const MagSample& s) {
   } else {
     qsf_.reset();
   }  // no gyro frame to test the field's stationarity in
-  if (have_rv_ && ns_to_s(s.t_ns - last_rv_ns_) <= opt_.heading.rv_max_age_s) return;  // RV wins
+  if (rv_fresh) return;  // RV wins
   if (!compass) return;
   absolute_heading(s.t_ns, *compass,
                    qsf_weight() * mag_accuracy_weight_ * fusion_.field_weight(field_ut, tracker_.up_phone()),
                    HeadingSource::kCompass, fusion_.field_deflection_sigma_rad(field_ut, tracker_.up_phone()));
+}
+
+bool Pdr::hard_iron_moved(Eigen::Vector3d& since_ut, double change_ut) {
+  if (!(change_ut > 0.0) || (magcal_.bias_ut() - since_ut).norm() < change_ut) return false;
+  since_ut = magcal_.bias_ut();
+  return true;
 }
 
 void Pdr::feed(const SensorAccuracySample& s) {
@@ -615,7 +618,8 @@ void Pdr::feed(const RotationVectorSample& s) {
   // The rotation vector is the phone's own gyro+magnetometer fusion: it is as disturbed as
   // the field it used, so it is weighted by the latest magnetometer reading's tests.
   const bool mag_fresh = have_mag_last_ && ns_to_s(s.t_ns - mag_last_ns_) <= opt_.heading.rv_max_age_s;
-  double w = mag_fresh && tracker_.has_gravity() ? fusion_.field_weight(last_field_ut_, tracker_.up_phone()) : 1.0;
+  const bool field_tested = mag_fresh && tracker_.has_gravity();
+  double w = field_tested ? fusion_.field_weight(last_field_ut_, tracker_.up_phone()) : 1.0;
   w *= mag_accuracy_weight_;
   if (mag_fresh) w *= qsf_weight();  // the RV used this field: trusted only while it is quasi-static
   // the sensor's own heading accuracy (when it reports one): inverse-variance relative to one
@@ -623,7 +627,7 @@ void Pdr::feed(const RotationVectorSample& s) {
   if (std::isfinite(s.heading_accuracy_rad) && s.heading_accuracy_rad > 0.0)
     w *= std::clamp(std::pow(opt_.fusion.base_sigma_rad / s.heading_accuracy_rad, 2), opt_.fusion.disturbed_weight, 1.0);
   absolute_heading(s.t_ns, *h, w, HeadingSource::kRotationVector,
-                   mag_fresh && tracker_.has_gravity() ? fusion_.field_deflection_sigma_rad(last_field_ut_, tracker_.up_phone()) : 0.0);
+                   field_tested ? fusion_.field_deflection_sigma_rad(last_field_ut_, tracker_.up_phone()) : 0.0);
 }
 
 void Pdr::feed(const StepDetectorSample& s) {

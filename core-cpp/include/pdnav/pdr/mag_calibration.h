@@ -99,7 +99,7 @@ struct MagCalibrationOptions {
   // iron measure another offset, and a line through both reads the calibration's step as drift
   // (ETH walk with a 44 uT hard iron: 0.3 deg/s at the first step, 0.7 a minute on, its segments
   // 13-28 deg off). 10 uT: up to 30 deg across a 20 uT horizontal field, where the converging bias
-  // moves by 1-7 uT (kept: the drift learned with it).
+  // moves by 1-7 uT (kept: the drift learned with it). 0 = off.
   double drift_restart_change_ut = 10.0;
 };
 

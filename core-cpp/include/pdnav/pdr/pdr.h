@@ -379,8 +379,10 @@ class Pdr {
   HeadingFusion fusion_;
   QuasiStaticField qsf_;
   MagCalibration magcal_;
-  Eigen::Vector3d compass_bias_ut_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d drift_bias_ut_ = Eigen::Vector3d::Zero();  // hard iron the gyro drift was learned with  // hard iron the compass offset was learned with
+  Eigen::Vector3d compass_bias_ut_ = Eigen::Vector3d::Zero();  // hard iron the compass offset was learned with
+  Eigen::Vector3d drift_bias_ut_ = Eigen::Vector3d::Zero();    // hard iron the gyro drift was learned with
+  /// The hard iron in use moved at least change_ut (0 = never) from since_ut, which then takes it.
+  bool hard_iron_moved(Eigen::Vector3d& since_ut, double change_ut);
   Eigen::Vector3d fusion_reference_;  // the reference axis fusion_'s offset refers to
   double qsf_weight() const { return qsf_.quasi_static() ? 1.0 : opt_.fusion.non_qsf_weight; }
   std::int64_t placement_revision_ = 0;
