@@ -8,7 +8,7 @@
 // capture, tools/tyrex2log) use --segment-min-m (a segment ends once the truth has moved that
 // far along its path) and --align-start-s (the track rotated about the start to fit the truth
 // over the first seconds: relative heading, the RMS % of distance). --sensors keeps
-// one sensor set of the log (accel, imu, rv, uncal, game, accelmag, all); --rate, --turn,
+// one sensor set of the log (accel, imu, rv, uncal, game, accelmag, all); --speed, --rate, --turn,
 // --pitch and --wave replay the walk as another phone, grip or start would give it; --json writes one object per
 // walk (Meta Carry/Gait/Disturbance/TruthSteps included) for tools/eval-pdr-all.
 // Last line: `median_mean_error_m: X median_length_ratio: Y`.
@@ -50,6 +50,7 @@
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/phonesim/handling.h"
 #include "pdnav/phonesim/sample_rate.h"
+#include "pdnav/phonesim/walk_speed.h"
 #include "support/eval_support.h"
 #include "support/output_file.h"
 #include "support/replay_support.h"
@@ -80,6 +81,7 @@ struct EvalPdrArgs {
   double wave_amplitude = 1.0;
   double pitch_deg = 0.0;     // every walk with the phone pitched this much further (0 = as recorded)
   double rate_hz = 0.0;       // motion sensors block-averaged to at most this rate (0 = as recorded)
+  double speed = 1.0;         // the walk this many times faster along the same path (1 = as recorded)
   double turn_deg = 0.0;      // every walk with the phone turned this much in the hand about its Z axis
   std::vector<double> hard_iron_ut;  // every walk's magnetometer with this hard iron left in it (empty = as recorded)
   std::string sensors = "all";  // sensor set kept from each log (sensor_set_keeps)
@@ -594,6 +596,7 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a, const std::s
     }
   }
   TimeNs walk_start_ns = std::numeric_limits<TimeNs>::min();
+  if (a.speed != 1.0) samples = phonesim::at_walk_speed(samples, a.speed);
   if (a.rate_hz > 0.0) samples = phonesim::at_sample_rate(samples, a.rate_hz);
   if (a.turn_deg != 0.0) samples = with_turn(samples, a.turn_deg);
   if (a.pitch_deg != 0.0) samples = with_pitch(samples, a.pitch_deg, path);
@@ -982,6 +985,11 @@ void register_eval_pdr(CLI::App& app) {
                  "motion sensors as a phone sampling at most this rate would record them (Hz; each "
                  "accelerometer / gyroscope / magnetometer stream block-averaged, rotation vectors decimated)")
       ->check(CLI::Range(5.0, 1000.0));
+  c->add_option("--speed", a->speed,
+                 "every walk taken this many times faster along the same path (the cadence times it, the steps "
+                 "as many): gravity kept, the gait's acceleration times its square, angular rates times it "
+                 "(phonesim/walk_speed.h; before --rate)")
+      ->check(CLI::Range(0.25, 4.0));
   c->add_option("--turn", a->turn_deg,
                  "every walk with the phone turned this much in the hand about its screen's normal (deg, + = "
                  "counter-clockwise seen from the screen; 90 = held in landscape): the same walk, another grip")

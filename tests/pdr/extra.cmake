@@ -156,7 +156,7 @@ set_tests_properties(pdr_cli_eval_pdr_all PROPERTIES LABELS "pdr;cli" FIXTURES_R
 # eval-pdr-all --compare: the same two TYREX walks evaluated twice (the second run against the
 # first's per-walk JSON) move nothing (deterministic), and a folder that is not a run is refused.
 add_test(NAME pdr_cli_eval_pdr_all_compare
-         COMMAND sh -c "d=\"$2\"; rm -rf \"$d\"; mkdir -p \"$d/a\" \"$d/b\" || exit 1; ln -s \"$1/logs\" \"$d/a/logs\"; ln -s \"$1/logs\" \"$d/b/logs\"; for r in a b; do c=''; [ $r = b ] && c=\"--compare $d/a\"; /usr/bin/python3 \"$0\" --sets tyrex --no-convert --rates '' --hard-iron '' --out \"$d/$r\" --pdnav \"$3\" $c > \"$d/$r.txt\" 2>&1 || exit 1; done; grep '^compare' \"$d/b.txt\"; /usr/bin/python3 \"$0\" --sets tyrex --no-convert --out \"$d/b\" --pdnav \"$3\" --compare \"$d/none\" 2>&1 | tail -1"
+         COMMAND sh -c "d=\"$2\"; rm -rf \"$d\"; mkdir -p \"$d/a\" \"$d/b\" || exit 1; ln -s \"$1/logs\" \"$d/a/logs\"; ln -s \"$1/logs\" \"$d/b/logs\"; for r in a b; do c=''; [ $r = b ] && c=\"--compare $d/a\"; /usr/bin/python3 \"$0\" --sets tyrex --no-convert --rates '' --speeds '' --hard-iron '' --out \"$d/$r\" --pdnav \"$3\" $c > \"$d/$r.txt\" 2>&1 || exit 1; done; grep '^compare' \"$d/b.txt\"; /usr/bin/python3 \"$0\" --sets tyrex --no-convert --out \"$d/b\" --pdnav \"$3\" --compare \"$d/none\" 2>&1 | tail -1"
                  "${PROJECT_SOURCE_DIR}/tools/eval-pdr-all" "${_pdr_tyrex_out}" "${PROJECT_BINARY_DIR}/test-scratch/pdr-all-compare"
                  $<TARGET_FILE:pdnav>)
 set_tests_properties(pdr_cli_eval_pdr_all_compare PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
@@ -170,6 +170,15 @@ add_test(NAME pdr_cli_eval_pdr_rate
                  "${PROJECT_BINARY_DIR}/test-scratch/pdr-rate-logs")
 set_tests_properties(pdr_cli_eval_pdr_rate PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
                      PASS_REGULAR_EXPRESSION "\nquarter\nsame")
+# eval-pdr --speed: the texting walk taken 1.25 times faster keeps every accelerometer line over
+# 1 / 1.25 of the time (written with --write-logs), its Truth lines too, and --speed 1 leaves
+# the walk as recorded (the per-walk line identical to the one without it).
+add_test(NAME pdr_cli_eval_pdr_speed
+         COMMAND sh -c "d=\"$2\"; rm -rf \"$d\"; mkdir -p \"$d\" || exit 1; \"$0\" eval-pdr --quiet --speed 1.25 --write-logs \"$d\" \"$1\" >/dev/null 2>&1 || exit 1; w=\"$d/$(basename \"$1\")\"; span() { grep '^Accel,' \"$1\" | awk -F, 'NR==1{a=$3} {b=$3} END{printf \"%d\", (b-a)/1000000}'; }; s0=$(span \"$1\"); s1=$(span \"$w\"); echo \"accel span ms $s0 -> $s1\"; [ $((125 * s1)) -ge $((99 * s0)) ] && [ $((125 * s1)) -le $((101 * s0)) ] && [ $(grep -c '^Accel,' \"$1\") -eq $(grep -c '^Accel,' \"$w\") ] && [ $(grep -c '^Truth,' \"$1\") -eq $(grep -c '^Truth,' \"$w\") ] && echo faster; a=$(\"$0\" eval-pdr --quiet \"$1\" 2>/dev/null | grep '^Guillaume'); b=$(\"$0\" eval-pdr --quiet --speed 1 \"$1\" 2>/dev/null | grep '^Guillaume'); [ -n \"$a\" ] && [ \"$a\" = \"$b\" ] && echo same; \"$0\" eval-pdr --quiet --speed 9 \"$1\" 2>&1 | grep -- --speed"
+                 $<TARGET_FILE:pdnav> "${_pdr_tyrex_out}/logs/tyrex/Guillaume_Nexus5_NoDist_Texting.log"
+                 "${PROJECT_BINARY_DIR}/test-scratch/pdr-speed-logs")
+set_tests_properties(pdr_cli_eval_pdr_speed PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_tyrex
+                     PASS_REGULAR_EXPRESSION "\nfaster\nsame\n--speed: Value 9 not in range")
 # eval-pdr --hard-iron: the written log's magnetometer lines are the recorded ones plus the hard
 # iron (to 1e-4 uT), its rotation vectors are gone (computed from the field it changed), and a
 # value that is not three numbers is refused with what was expected.

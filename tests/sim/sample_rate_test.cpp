@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "samples_of_type.h"
+
 #include "pdnav/phonesim/sample_rate.h"
 
 namespace pdnav::phonesim {
@@ -15,13 +17,7 @@ namespace {
 
 constexpr TimeNs kMs = 1000000;
 
-template <typename S>
-std::vector<S> only(const std::vector<Sample>& in) {
-  std::vector<S> out;
-  for (const Sample& s : in)
-    if (const auto* x = std::get_if<S>(&s)) out.push_back(*x);
-  return out;
-}
+using test::only;
 
 TEST(SampleRate, BlocksOfTheGridAreAveragedAndStampedWithTheirLastSample) {
   // 200 Hz accelerometer x = 0, 1, 2, ...; uncalibrated gyroscope with a drift that counts too.

@@ -164,7 +164,7 @@ void GyroTurnTracker::feed(const GyroSample& s) {
   gyro_last_ns_ = s.t_ns;
   gyro_last_ = s.rate_radps;
   if (!have_gravity_) return;
-  history_.push_back({s.t_ns, yaw_rad_});
+  history_.push_back({s.t_ns, yaw_rad_, axis_yaw_rad()});
   trim_history(s.t_ns);
   update_turn_state(s.t_ns);
 }
@@ -172,6 +172,16 @@ void GyroTurnTracker::feed(const GyroSample& s) {
 void GyroTurnTracker::trim_history(TimeNs t_ns) {
   const TimeNs keep = s_to_ns(3.0 * opt_.window_s);
   while (!history_.empty() && history_.front().t_ns < t_ns - keep) history_.pop_front();
+}
+
+std::optional<double> GyroTurnTracker::axis_yaw_rad_at(TimeNs t_ns) const {
+  if (history_.empty() || t_ns < history_.front().t_ns || t_ns > history_.back().t_ns) return std::nullopt;
+  const auto after = std::lower_bound(history_.begin(), history_.end(), t_ns,
+                                      [](const YawAt& y, TimeNs t) { return y.t_ns < t; });
+  if (after == history_.begin() || after->t_ns == t_ns) return after->axis_yaw;
+  const auto before = after - 1;
+  const double f = static_cast<double>(t_ns - before->t_ns) / static_cast<double>(after->t_ns - before->t_ns);
+  return before->axis_yaw + f * (after->axis_yaw - before->axis_yaw);
 }
 
 bool GyroTurnTracker::window_straight() const {

@@ -360,6 +360,16 @@ Pdr::HeldStep Pdr::hold(const StepCandidate& c) const {
   // the configured initial heading (heading_rad() adds the declination only in the first case).
   h.magnetic = fusion_.valid();
   h.heading_rad = wrap_two_pi(heading_rad() - (h.magnetic ? declination_rad_ : 0.0));
+  // A step placed inside a longer interval (a stride's midpoint, a run's missed steps) is
+  // behind the heading now by its share of the turn over that interval: the reference axis'
+  // yaw at the interval's two ends (candidates both, at the same phase of the gait, so that an
+  // arm's or a thigh's swing cancels) interpolated to the step's time (heading = - yaw + const).
+  if (c.placed_from_ns > 0 && c.placed_from_ns < c.t_ns && c.t_ns < latest_ns_) {
+    if (const std::optional<double> from = tracker_.axis_yaw_rad_at(c.placed_from_ns)) {
+      const double share = static_cast<double>(latest_ns_ - c.t_ns) / static_cast<double>(latest_ns_ - c.placed_from_ns);
+      h.heading_rad = wrap_two_pi(h.heading_rad + share * (tracker_.axis_yaw_rad() - *from));
+    }
+  }
   h.heading_sigma_rad = heading_sigma_rad();
   h.source = heading_source(c.t_ns);
   if (opt_.heading.mount == Mount::kAuto) {

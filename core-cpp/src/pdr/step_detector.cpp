@@ -230,7 +230,81 @@ void StepDetector::feed(const GyroSample& s) {
   while (!rates_.empty() && rates_.front().t_ns < s.t_ns - keep) rates_.pop_front();
 }
 
+double StepDetector::running_step_period_s(TimeNs t_ns) const {
+  constexpr double kBin = 0.02;
+  const std::size_t n = static_cast<std::size_t>(std::lround(opt_.running_period_window_s / kBin));
+  if (n < 4) return 0.0;
+  const TimeNs from = t_ns - s_to_ns(static_cast<double>(n) * kBin);
+  std::vector<double> sum(n, 0.0);
+  std::vector<int> count(n, 0);
+  for (const auto& h : history_) {
+    if (h.t_ns < from || h.t_ns >= t_ns) continue;
+    const auto i = static_cast<std::size_t>(static_cast<double>(h.t_ns - from) * 1e-9 / kBin);
+    if (i < n) sum[i] += h.raw, ++count[i];
+  }
+  // a bin without a sample (a rate below 50 Hz, jitter) repeats the previous one; a hole of more
+  // than 0.1 s (or none at the start) gives no period
+  std::vector<double> x(n);
+  std::size_t empty_run = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (count[i] > 0) {
+      x[i] = sum[i] / count[i];
+      empty_run = 0;
+    } else {
+      if (i == 0 || static_cast<double>(++empty_run) * kBin > 0.1) return 0.0;
+      x[i] = x[i - 1];
+    }
+  }
+  const auto corr = [&](std::size_t lag) {  // normalised (Pearson) autocorrelation at lag bins
+    const std::size_t m = n - lag;
+    double ma = 0.0, mb = 0.0;
+    for (std::size_t i = 0; i < m; ++i) ma += x[i], mb += x[i + lag];
+    ma /= static_cast<double>(m), mb /= static_cast<double>(m);
+    double ab = 0.0, aa = 0.0, bb = 0.0;
+    for (std::size_t i = 0; i < m; ++i) {
+      const double a = x[i] - ma, b = x[i + lag] - mb;
+      ab += a * b, aa += a * a, bb += b * b;
+    }
+    return aa > 0.0 && bb > 0.0 ? ab / std::sqrt(aa * bb) : 0.0;
+  };
+  const auto lag_min = static_cast<std::size_t>(std::lround(opt_.running_stride_lag_min_s / kBin));
+  const auto lag_max = std::min(n / 2, static_cast<std::size_t>(std::lround(opt_.running_stride_lag_max_s / kBin)));
+  double best = -1.0;
+  std::size_t best_lag = 0;
+  for (std::size_t lag = std::max<std::size_t>(1, lag_min); lag <= lag_max; ++lag) {
+    const double r = corr(lag);
+    if (r > best) best = r, best_lag = lag;
+  }
+  if (best_lag == 0 || best < opt_.running_period_min_corr) return 0.0;
+  return 0.5 * static_cast<double>(best_lag) * kBin;
+}
+
+bool StepDetector::fill_run(const StepCandidate& c, std::vector<StepCandidate>& out) {
+  if (!running_ || opt_.running_period_window_s <= 0.0 || !(c.interval_s > 0.0) ||
+      c.interval_s > opt_.running_fill_max_interval_s)
+    return false;
+  const double period = running_step_period_s(c.t_ns);
+  if (!(period > 0.0)) return false;
+  const double ratio = c.interval_s / period;
+  const long steps = std::lround(ratio);
+  if (steps < 2 || std::abs(ratio - static_cast<double>(steps)) > opt_.running_fill_tolerance) return false;
+  const double each = c.interval_s / static_cast<double>(steps);
+  for (long k = steps - 1; k >= 0; --k) {
+    StepCandidate s = c;
+    s.t_ns = c.t_ns - s_to_ns(static_cast<double>(k) * each);
+    s.interval_s = each;
+    if (k > 0) s.placed_from_ns = c.t_ns - s_to_ns(c.interval_s);
+    out.push_back(s);
+  }
+  stride_steps_added_ += steps - 1;
+  if (typical_before_s_ > 0.0)  // the cadence goes on at the period (the interval held several steps)
+    typical_interval_s_ = typical_before_s_ + kIntervalGain * (each - typical_before_s_);
+  prev_stride_like_ = false;
+  return true;
+}
+
 void StepDetector::split_strides(const StepCandidate& c, std::vector<StepCandidate>& out) {
+  if (fill_run(c, out)) return;
   bool by_gyro = false;
   const bool like = stride_like(c.t_ns, c.interval_s, &by_gyro);
   // Walking: two in a row (one odd long interval may be a pause), or one of twice the bout's
@@ -249,6 +323,7 @@ void StepDetector::split_strides(const StepCandidate& c, std::vector<StepCandida
   StepCandidate mid = c;
   mid.t_ns = c.t_ns - s_to_ns(0.5 * c.interval_s);
   mid.interval_s = 0.5 * c.interval_s;
+  mid.placed_from_ns = c.t_ns - s_to_ns(c.interval_s);
   StepCandidate second = c;
   second.interval_s = 0.5 * c.interval_s;
   out.push_back(mid);
@@ -283,7 +358,7 @@ std::vector<StepCandidate> StepDetector::feed(const AccelSample& s) {
       detail::lowpass2(lpv1_, lpv2_, s.acc_mps2, detail::lowpass_gain(dt_s, std::max(opt_.lowpass_hz, 1.0)));
     }
     const double norm = lpv2_.norm();
-    history_.push_back({s.t_ns, value, norm > 1e-6 ? Eigen::Vector3d(lpv2_ / norm) : Eigen::Vector3d::UnitZ()});
+    history_.push_back({s.t_ns, value, s.acc_mps2.norm(), norm > 1e-6 ? Eigen::Vector3d(lpv2_ / norm) : Eigen::Vector3d::UnitZ()});
     const TimeNs keep = s_to_ns(2.0 * opt_.stride_max_interval_s);
     while (!history_.empty() && history_.front().t_ns < s.t_ns - keep) history_.pop_front();
   }

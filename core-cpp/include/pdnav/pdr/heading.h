@@ -88,6 +88,9 @@ class GyroTurnTracker {
 
   /// Integrated yaw about the vertical since start (rad, left positive); valid once gravity is known.
   double yaw_rad() const { return yaw_rad_; }
+  /// axis_yaw_rad() as it was at t_ns (linear between the gyro samples kept, the last 3
+  /// windows); nullopt when t_ns is outside them.
+  std::optional<double> axis_yaw_rad_at(TimeNs t_ns) const;
   /// The phone axis whose heading axis_yaw_rad() follows (the heading filter's reference axis).
   void set_yaw_axis(const Eigen::Vector3d& axis_phone);
   /// Yaw (rad, left positive, continuous) of the yaw axis' horizontal projection in the
@@ -110,6 +113,7 @@ class GyroTurnTracker {
   struct YawAt {
     TimeNs t_ns;
     double yaw;
+    double axis_yaw;  // axis_yaw_rad() then
   };
   void update_turn_state(TimeNs t_ns);
   bool window_straight() const;
