@@ -81,7 +81,7 @@ struct MetaStart {
     if (utc_ms == kMissingInt) {
       std::visit(
           [&](const auto& x) {
-            if constexpr (has_utc_field<std::decay_t<decltype(x)>>::value)
+            if constexpr (has_utc<std::decay_t<decltype(x)>>::value)
               if (x.utc_ms != kMissingInt && x.utc_ms > 0) utc_ms = x.utc_ms;
           },
           s);
@@ -97,11 +97,6 @@ struct MetaStart {
     applied = true;
     applied_utc_ms = utc_ms;
   }
-
-  template <typename T, typename = void>
-  struct has_utc_field : std::false_type {};
-  template <typename T>
-  struct has_utc_field<T, std::void_t<decltype(std::declval<T>().utc_ms)>> : std::true_type {};
 };
 
 std::string describe_frame(const pdr::Pdr& engine, const MetaStart& start) {

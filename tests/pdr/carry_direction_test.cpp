@@ -595,7 +595,7 @@ namespace {
 Recording at_speed(const Recording& r, double k, CapturedWalk* span) {
   const std::vector<Sample> all = samples_of(r);
   TimeNs t0 = std::numeric_limits<TimeNs>::max();
-  for (const Sample& s : all) t0 = std::min(t0, std::visit([](const auto& x) { return x.t_ns; }, s));
+  for (const Sample& s : all) t0 = std::min(t0, sample_time_ns(s));
   const double t0_s = ns_to_s(t0);
   span->from_s = t0_s + (span->from_s - t0_s) / k;
   span->to_s = t0_s + (span->to_s - t0_s) / k;

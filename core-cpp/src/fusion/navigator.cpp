@@ -108,11 +108,6 @@ struct IntervalAverage {
   double fresh_limit_s(double base_s) const { return std::max(base_s, 1.5 * s + 1.0); }
 };
 
-template <typename T, typename = void>
-struct has_utc : std::false_type {};
-template <typename T>
-struct has_utc<T, std::void_t<decltype(std::declval<T>().utc_ms)>> : std::true_type {};
-
 /// elapsedRealtimeNanos is >= 0 and far below 2^62 (146 years); outside that range a time is
 /// corrupt, and admitting it would let time differences downstream overflow int64.
 bool time_in_range(TimeNs t) { return t >= 0 && t <= (TimeNs{1} << 62); }

@@ -6,6 +6,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "autocorrelation.h"
+
 namespace pdnav::pdr {
 
 const char* to_string(MotionState m) {
@@ -175,21 +177,9 @@ void MotionClassifier::vehicle_evaluate(TimeNs t_ns) {
   for (std::size_t i = 0; i < n; ++i) x[i] = bins_[i].n > 0 ? bins_[i].sum / bins_[i].n : (i ? x[i - 1] : 0.0);
   const auto lag_min = static_cast<std::size_t>(std::lround(opt_.gait_lag_min_s / opt_.vehicle_bin_s));
   const auto lag_max = std::min(n - 2, static_cast<std::size_t>(std::lround(opt_.gait_lag_max_s / opt_.vehicle_bin_s)));
-  double corr = -1.0;
-  std::size_t best_lag = 0;
-  for (std::size_t lag = std::max<std::size_t>(1, lag_min); lag <= lag_max; ++lag) {
-    const std::size_t m = n - lag;
-    double ma = 0, mb = 0;
-    for (std::size_t i = 0; i < m; ++i) ma += x[i], mb += x[i + lag];
-    ma /= static_cast<double>(m);
-    mb /= static_cast<double>(m);
-    double ab = 0, aa = 0, bb = 0;
-    for (std::size_t i = 0; i < m; ++i) {
-      const double a = x[i] - ma, b = x[i + lag] - mb;
-      ab += a * b, aa += a * a, bb += b * b;
-    }
-    if (aa > 0 && bb > 0 && ab / std::sqrt(aa * bb) > corr) corr = ab / std::sqrt(aa * bb), best_lag = lag;
-  }
+  const detail::BestLag periodic = detail::best_autocorrelation(x, lag_min, lag_max);
+  const double corr = periodic.corr;
+  const std::size_t best_lag = periodic.lag;
   gait_corr_ = corr;
   // gait coherence: the angular-rate vector (bin means) repeats at the |a| lag or twice it
   double coherence = 0.0;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <complex>
 
+#include "autocorrelation.h"
 #include "lowpass.h"
 
 namespace pdnav::pdr {
@@ -230,16 +231,19 @@ void StepDetector::feed(const GyroSample& s) {
   while (!rates_.empty() && rates_.front().t_ns < s.t_ns - keep) rates_.pop_front();
 }
 
+namespace {
+constexpr double kPeriodBinS = 0.02;  // the run's |a| in 20 ms bins for its autocorrelation
+}  // namespace
+
 double StepDetector::running_step_period_s(TimeNs t_ns) const {
-  constexpr double kBin = 0.02;
-  const std::size_t n = static_cast<std::size_t>(std::lround(opt_.running_period_window_s / kBin));
+  const std::size_t n = static_cast<std::size_t>(std::lround(opt_.running_period_window_s / kPeriodBinS));
   if (n < 4) return 0.0;
-  const TimeNs from = t_ns - s_to_ns(static_cast<double>(n) * kBin);
+  const TimeNs from = t_ns - s_to_ns(static_cast<double>(n) * kPeriodBinS);
   std::vector<double> sum(n, 0.0);
   std::vector<int> count(n, 0);
   for (const auto& h : history_) {
     if (h.t_ns < from || h.t_ns >= t_ns) continue;
-    const auto i = static_cast<std::size_t>(static_cast<double>(h.t_ns - from) * 1e-9 / kBin);
+    const auto i = static_cast<std::size_t>(static_cast<double>(h.t_ns - from) * 1e-9 / kPeriodBinS);
     if (i < n) sum[i] += h.raw, ++count[i];
   }
   // a bin without a sample (a rate below 50 Hz, jitter) repeats the previous one; a hole of more
@@ -251,37 +255,25 @@ double StepDetector::running_step_period_s(TimeNs t_ns) const {
       x[i] = sum[i] / count[i];
       empty_run = 0;
     } else {
-      if (i == 0 || static_cast<double>(++empty_run) * kBin > 0.1) return 0.0;
+      if (i == 0 || static_cast<double>(++empty_run) * kPeriodBinS > 0.1) return 0.0;
       x[i] = x[i - 1];
     }
   }
-  const auto corr = [&](std::size_t lag) {  // normalised (Pearson) autocorrelation at lag bins
-    const std::size_t m = n - lag;
-    double ma = 0.0, mb = 0.0;
-    for (std::size_t i = 0; i < m; ++i) ma += x[i], mb += x[i + lag];
-    ma /= static_cast<double>(m), mb /= static_cast<double>(m);
-    double ab = 0.0, aa = 0.0, bb = 0.0;
-    for (std::size_t i = 0; i < m; ++i) {
-      const double a = x[i] - ma, b = x[i + lag] - mb;
-      ab += a * b, aa += a * a, bb += b * b;
-    }
-    return aa > 0.0 && bb > 0.0 ? ab / std::sqrt(aa * bb) : 0.0;
-  };
-  const auto lag_min = static_cast<std::size_t>(std::lround(opt_.running_stride_lag_min_s / kBin));
-  const auto lag_max = std::min(n / 2, static_cast<std::size_t>(std::lround(opt_.running_stride_lag_max_s / kBin)));
-  double best = -1.0;
-  std::size_t best_lag = 0;
-  for (std::size_t lag = std::max<std::size_t>(1, lag_min); lag <= lag_max; ++lag) {
-    const double r = corr(lag);
-    if (r > best) best = r, best_lag = lag;
-  }
-  if (best_lag == 0 || best < opt_.running_period_min_corr) return 0.0;
-  return 0.5 * static_cast<double>(best_lag) * kBin;
+  const auto lag_min = static_cast<std::size_t>(std::lround(opt_.running_stride_lag_min_s / kPeriodBinS));
+  const auto lag_max = std::min(n / 2, static_cast<std::size_t>(std::lround(opt_.running_stride_lag_max_s / kPeriodBinS)));
+  const detail::BestLag stride = detail::best_autocorrelation(x, lag_min, lag_max);
+  if (stride.lag == 0 || stride.corr < opt_.running_period_min_corr) return 0.0;
+  return 0.5 * static_cast<double>(stride.lag) * kPeriodBinS;
 }
 
 bool StepDetector::fill_run(const StepCandidate& c, std::vector<StepCandidate>& out) {
+  // the shortest period the autocorrelation can give (its shortest stride lag, in bins): an
+  // interval shorter than 2 of them less the tolerance holds one step, and needs no period
+  const double shortest_period_s =
+      0.5 * kPeriodBinS * std::max(1.0, std::round(opt_.running_stride_lag_min_s / kPeriodBinS));
   if (!running_ || opt_.running_period_window_s <= 0.0 || !(c.interval_s > 0.0) ||
-      c.interval_s > opt_.running_fill_max_interval_s)
+      c.interval_s > opt_.running_fill_max_interval_s ||
+      c.interval_s < (2.0 - opt_.running_fill_tolerance) * shortest_period_s)
     return false;
   const double period = running_step_period_s(c.t_ns);
   if (!(period > 0.0)) return false;

@@ -8,7 +8,6 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
-#include <utility>
 #include <variant>
 
 #include <Eigen/Core>
@@ -25,7 +24,7 @@ std::vector<Eigen::Vector3d> zero_phase_lowpass(const std::vector<TimeNs>& t, co
   if (x.empty()) return y;
   const auto gain = [&](std::size_t a, std::size_t b) {
     const double dt = std::abs(static_cast<double>(t[b] - t[a])) * 1e-9;
-    return 1.0 - std::exp(-2.0 * M_PI * cutoff_hz * dt);
+    return 1.0 - std::exp(-2.0 * kPi * cutoff_hz * dt);
   };
   Eigen::Vector3d s1 = y.front(), s2 = y.front();
   for (std::size_t i = 0; i < y.size(); ++i) {
@@ -44,24 +43,13 @@ std::vector<Eigen::Vector3d> zero_phase_lowpass(const std::vector<TimeNs>& t, co
   return y;
 }
 
-/// Whether a sample type carries a wall-clock time (utc_ms).
-template <typename T, typename = void>
-struct HasUtc : std::false_type {};
-template <typename T>
-struct HasUtc<T, std::void_t<decltype(std::declval<T&>().utc_ms)>> : std::true_type {};
-
-/// t_ns of any sample.
-TimeNs time_of(const Sample& s) {
-  return std::visit([](const auto& x) { return x.t_ns; }, s);
-}
-
 }  // namespace
 
 std::vector<Sample> at_walk_speed(const std::vector<Sample>& in, double k, double slow_hz) {
   if (!(k >= 0.25 && k <= 4.0)) throw std::invalid_argument("at_walk_speed: the speed factor must be in [0.25, 4]");
   if (!(slow_hz > 0.0) || !std::isfinite(slow_hz)) throw std::invalid_argument("at_walk_speed: slow_hz must be > 0");
   TimeNs t0 = std::numeric_limits<TimeNs>::max();
-  for (const Sample& s : in) t0 = std::min(t0, time_of(s));
+  for (const Sample& s : in) t0 = std::min(t0, sample_time_ns(s));
   const auto faster = [&](TimeNs t) { return t0 + static_cast<TimeNs>(std::llround(static_cast<double>(t - t0) / k)); };
 
   // The slow part of each accelerometer stream (calibrated, uncalibrated), on its own time line.
@@ -86,7 +74,7 @@ std::vector<Sample> at_walk_speed(const std::vector<Sample>& in, double k, doubl
           using T = std::decay_t<decltype(x)>;
           const TimeNs before = x.t_ns;
           x.t_ns = faster(x.t_ns);
-          if constexpr (HasUtc<T>::value) {
+          if constexpr (has_utc<T>::value) {
             if (x.utc_ms != kMissingInt) x.utc_ms -= (before - x.t_ns) / 1000000;
           }
           if constexpr (std::is_same_v<T, AccelSample>) {

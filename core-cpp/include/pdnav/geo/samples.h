@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -163,5 +165,12 @@ using Sample = std::variant<AccelSample, GyroSample, MagSample, UncalAccelSample
 inline TimeNs sample_time_ns(const Sample& s) {
   return std::visit([](const auto& x) { return x.t_ns; }, s);
 }
+
+/// Whether sample type T carries a wall-clock time (utc_ms): the sensor and GNSS lines, not
+/// Truth, Meta or Nav.
+template <typename T, typename = void>
+struct has_utc : std::false_type {};
+template <typename T>
+struct has_utc<T, std::void_t<decltype(std::declval<T>().utc_ms)>> : std::true_type {};
 
 }  // namespace pdnav
