@@ -168,6 +168,8 @@ class NaivePdr {
 struct WalkResult {
   std::string name;
   std::vector<double> errors_m, naive_errors_m, seg_heading_err_deg, naive_seg_heading_err_deg;
+  // per segment: the RMS of the stated heading 1-sigma of the steps in it (NaN: no step)
+  std::vector<double> seg_heading_sigma_deg;
   double mean_m = kNaN, naive_mean_m = kNaN, length_ratio = kNaN, naive_ratio = kNaN;
   std::int64_t steps = 0;
   double declination_deg = kNaN;
@@ -275,7 +277,10 @@ class Runner {
   void feed(const Sample& s) {
     if (nav_) {
       nav_->feed(s);
-      for (const fusion::StepEstimate& st : nav_->take_steps()) step_times_.push_back(st.estimate.t_ns);
+      for (const fusion::StepEstimate& st : nav_->take_steps()) {
+        step_times_.push_back(st.estimate.t_ns);
+        step_heading_sigma_rad_.push_back(st.heading_sigma_rad);
+      }
       return;
     }
     std::visit(
@@ -292,6 +297,7 @@ class Runner {
     for (const PdrStep& st : pdr_->take_steps()) {
       ++steps_;
       step_times_.push_back(st.t_ns);
+      step_heading_sigma_rad_.push_back(st.heading_sigma_rad);
       if (started_) {
         const Eigen::Vector2d d = st.length_m * Eigen::Vector2d(std::sin(st.heading_rad), std::cos(st.heading_rad));
         en_ += d;
@@ -333,6 +339,8 @@ class Runner {
   std::int64_t steps() const { return nav_ ? nav_->output(0).steps : steps_; }
   /// Each emitted step's own time (the dead-reckoning estimate's time after it).
   const std::vector<TimeNs>& step_times() const { return step_times_; }
+  /// Each emitted step's stated heading 1-sigma (PdrStep::heading_sigma_rad), with step_times().
+  const std::vector<double>& step_heading_sigma_rad() const { return step_heading_sigma_rad_; }
   /// Magnetometer readings tested for a quasi-static field and found so (direct Pdr only).
   std::pair<std::int64_t, std::int64_t> quasi_static_field() const {
     if (!pdr_) return {0, 0};
@@ -352,6 +360,7 @@ class Runner {
   double path_m_ = 0;
   std::int64_t steps_ = 0;
   std::vector<TimeNs> step_times_;
+  std::vector<double> step_heading_sigma_rad_;
   std::optional<Eigen::Matrix2d> cov_;
 };
 
@@ -579,6 +588,31 @@ std::vector<std::string> written_log_paths(const EvalPdrArgs& a) {
   return out;
 }
 
+/// RMS of the stated heading 1-sigma of the steps emitted in (from_ns, to_ns], degrees (NaN: no
+/// step with a finite sigma there): what a heading segment's error is judged against.
+double rms_step_sigma_deg(const Runner& run, TimeNs from_ns, TimeNs to_ns) {
+  const std::vector<TimeNs>& t = run.step_times();
+  const std::vector<double>& sigma = run.step_heading_sigma_rad();
+  double sq = 0;
+  int n = 0;
+  for (std::size_t k = std::upper_bound(t.begin(), t.end(), from_ns) - t.begin(); k < t.size() && t[k] <= to_ns; ++k)
+    if (k < sigma.size() && std::isfinite(sigma[k]) && sigma[k] > 0.0) sq += sigma[k] * sigma[k], ++n;
+  return n > 0 ? std::sqrt(sq / n) / kDegToRad : kNaN;
+}
+
+/// Segments whose heading error is within the stated 1-sigma of their steps, and segments with
+/// both (an honest Gaussian sigma holds 68 % of them).
+std::pair<std::int64_t, std::int64_t> heading_within_sigma(const WalkResult& r) {
+  std::int64_t within = 0, stated = 0;
+  for (std::size_t k = 0; k < r.seg_heading_err_deg.size() && k < r.seg_heading_sigma_deg.size(); ++k) {
+    const double e = r.seg_heading_err_deg[k], s = r.seg_heading_sigma_deg[k];
+    if (!std::isfinite(e) || !std::isfinite(s)) continue;
+    ++stated;
+    within += std::abs(e) <= s;
+  }
+  return {within, stated};
+}
+
 WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a, const std::string& write_path) {
   WalkResult r;
   r.name = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
@@ -698,6 +732,7 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a, const std::s
       if (seg_path_m >= a.segment_min_m) {  // a segment ends here (every Truth line when 0)
         const Eigen::Vector2d dt = tr - truth_en[seg_start];
         r.seg_heading_err_deg.push_back(segment_heading_error_deg(dt, est - est_en[seg_start]));
+        r.seg_heading_sigma_deg.push_back(rms_step_sigma_deg(run, truth_t[seg_start], t->t_ns));
         // the same for the naive PDR = the phone's own (magnetic) rotation-vector heading of +Y:
         // separates what the map frame and the field give from what our fusion adds
         r.naive_seg_heading_err_deg.push_back(segment_heading_error_deg(dt, naive.pos_en() - naive_en[seg_start]));
@@ -831,7 +866,11 @@ nlohmann::json walk_json(const WalkResult& r, const EvalPdrArgs& a) {
   j["naive_seg_heading_abs_median_deg"] = num(median(naive_abs_h));
   j["seg_heading_err_deg"] = r.seg_heading_err_deg;
   j["naive_seg_heading_err_deg"] = r.naive_seg_heading_err_deg;
-  for (auto* k : {"seg_heading_err_deg", "naive_seg_heading_err_deg"})
+  j["seg_heading_sigma_deg"] = r.seg_heading_sigma_deg;
+  const auto [within, stated] = heading_within_sigma(r);
+  j["seg_heading_stated"] = stated;
+  j["seg_heading_within_sigma"] = stated > 0 ? num(static_cast<double>(within) / static_cast<double>(stated)) : nlohmann::json(nullptr);
+  for (auto* k : {"seg_heading_err_deg", "naive_seg_heading_err_deg", "seg_heading_sigma_deg"})
     for (auto& x : j[k])
       if (!std::isfinite(x.get<double>())) x = nullptr;
   j["align_start_s"] = a.align_start_s;
@@ -918,6 +957,17 @@ int run_eval_pdr(const EvalPdrArgs& a) {
   if (any_naive)
     std::printf("naive (rotation vector +Y, magnetic, no declination): segment heading error median signed %.1f deg\n",
                 median(naive_herr));
+  std::int64_t h_within = 0, h_stated = 0;
+  std::vector<double> h_sigma;
+  for (const auto& r : all) {
+    const auto [w, n] = heading_within_sigma(r);
+    h_within += w, h_stated += n;
+    for (double x : r.seg_heading_sigma_deg) h_sigma.push_back(x);
+  }
+  if (h_stated > 0)
+    std::printf("segment heading error within its steps' stated 1-sigma (median %.1f deg): %.3f of %lld segments "
+                "(honest: 0.68)\n",
+                median(h_sigma), static_cast<double>(h_within) / static_cast<double>(h_stated), static_cast<long long>(h_stated));
   std::int64_t qsf_tested = 0, qsf_static = 0;
   for (const auto& r : all) qsf_tested += r.qsf_tested, qsf_static += r.qsf_static;
   if (qsf_tested > 0)

@@ -301,7 +301,7 @@ struct Navigator::Impl {
       }
       const PdrStep c = calibrated(s);
       walked_m += c.length_m;
-      step_estimates.push_back(StepEstimate{choose(), c.heading_rad, walked_m});
+      step_estimates.push_back(StepEstimate{choose(), c.heading_rad, walked_m, c.heading_sigma_rad});
       // a caller that never takes them (the app) must not grow memory: the newest are kept
       if (step_estimates.size() > kStepEstimatesKept) step_estimates.erase(step_estimates.begin());
     }

@@ -188,6 +188,7 @@ struct StepEstimate {
   Estimate estimate;            // after the step, at its time (status kNotInitialized before a start)
   double heading_rad = 0.0;     // the step's walking direction (calibrated), clockwise from true north
   double distance_m = 0.0;      // walked since the session start: sum of the (calibrated) step lengths
+  double heading_sigma_rad = 0.0;  // the PDR's stated 1-sigma of that direction (PdrStep::heading_sigma_rad)
 };
 
 class Navigator {
