@@ -965,7 +965,7 @@ int run_eval_pdr(const EvalPdrArgs& a) {
     for (double x : r.seg_heading_sigma_deg) h_sigma.push_back(x);
   }
   if (h_stated > 0)
-    std::printf("segment heading error within its steps' stated 1-sigma (median %.1f deg): %.3f of %lld segments "
+    std::printf("heading segments whose error is within their steps' stated 1-sigma (median %.1f deg): %.3f of %lld "
                 "(honest: 0.68)\n",
                 median(h_sigma), static_cast<double>(h_within) / static_cast<double>(h_stated), static_cast<long long>(h_stated));
   std::int64_t qsf_tested = 0, qsf_static = 0;
