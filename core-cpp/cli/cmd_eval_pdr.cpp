@@ -595,8 +595,8 @@ double rms_step_sigma_deg(const Runner& run, TimeNs from_ns, TimeNs to_ns) {
   const std::vector<double>& sigma = run.step_heading_sigma_rad();
   double sq = 0;
   int n = 0;
-  for (std::size_t k = std::upper_bound(t.begin(), t.end(), from_ns) - t.begin(); k < t.size() && t[k] <= to_ns; ++k)
-    if (k < sigma.size() && std::isfinite(sigma[k]) && sigma[k] > 0.0) sq += sigma[k] * sigma[k], ++n;
+  for (std::size_t k = 0; k < t.size() && k < sigma.size(); ++k)  // emission order: no sortedness assumed
+    if (t[k] > from_ns && t[k] <= to_ns && std::isfinite(sigma[k]) && sigma[k] > 0.0) sq += sigma[k] * sigma[k], ++n;
   return n > 0 ? std::sqrt(sq / n) / kDegToRad : kNaN;
 }
 
