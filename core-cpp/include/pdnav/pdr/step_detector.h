@@ -104,8 +104,8 @@ struct StepDetectorOptions {
   // a turn's slower steps fall between) and at most running_fill_max_interval_s. Where it does
   // not apply, running_single_stride's tests decide. TYREX runs, steps in the capture's span:
   // hand 295 -> 298 of 313, pocket 286 (unchanged) of 311; the 14 recordings taken 1.2 times
-  // faster (eval-pdr --speed 1.2, the runs at 3.3 steps/s): hand -24.6 -> -15.3 %, pocket
-  // -11.9 -> -9.3 %. 0 = off.
+  // faster (eval-pdr --speed 1.2, the runs at 3.3 steps/s): hand -26.2 -> -16.0 %, pocket
+  // -11.9 -> -10.0 % (tools/eval-pdr-all, as docs/pdr.md). 0 = off.
   double running_period_window_s = 3.0;
   double running_stride_lag_min_s = 0.5, running_stride_lag_max_s = 0.95;  // 2.1-4 steps/s
   double running_period_min_corr = 0.5;
