@@ -62,6 +62,12 @@ std::vector<Sample> at_walk_speed(const std::vector<Sample>& in, double k, doubl
   const std::vector<Eigen::Vector3d> slow_a = zero_phase_lowpass(ta, xa, slow_hz), slow_u = zero_phase_lowpass(tu, xu, slow_hz);
   std::size_t ia = 0, iu = 0;
   const double k2 = k * k;
+  // the gait (what is above the slow part) k^2 larger; slow[i] is this reading's slow part
+  const auto gait_faster = [k2](Eigen::Vector3d& acc, const std::vector<Eigen::Vector3d>& slow, std::size_t& i) {
+    if (!acc.allFinite()) return;
+    const Eigen::Vector3d& g = slow[i++];
+    acc = g + k2 * (acc - g);
+  };
 
   std::vector<Sample> out;
   out.reserve(in.size());
@@ -78,15 +84,9 @@ std::vector<Sample> at_walk_speed(const std::vector<Sample>& in, double k, doubl
             if (x.utc_ms != kMissingInt) x.utc_ms -= (before - x.t_ns) / 1000000;
           }
           if constexpr (std::is_same_v<T, AccelSample>) {
-            if (x.acc_mps2.allFinite()) {
-              const Eigen::Vector3d& g = slow_a[ia++];
-              x.acc_mps2 = g + k2 * (x.acc_mps2 - g);
-            }
+            gait_faster(x.acc_mps2, slow_a, ia);
           } else if constexpr (std::is_same_v<T, UncalAccelSample>) {
-            if (x.acc_mps2.allFinite()) {
-              const Eigen::Vector3d& g = slow_u[iu++];
-              x.acc_mps2 = g + k2 * (x.acc_mps2 - g);
-            }
+            gait_faster(x.acc_mps2, slow_u, iu);
           } else if constexpr (std::is_same_v<T, GyroSample>) {
             x.rate_radps *= k;
           } else if constexpr (std::is_same_v<T, UncalGyroSample>) {
