@@ -410,9 +410,9 @@ int run_eval_outage(const EvalOutageArgs& a) {
                   r.cal.epochs, r.cal.baseline_m, calibration_note(r.cal).c_str());
     else
       std::printf("  calibration published before the window: none (uncalibrated PDR in the window); last fit: scale "
-                  "%.3f +- %.3f, heading bias %.1f +- %.1f deg, %d epochs, baseline %.0f m, residual lag-1 corr. %.2f%s\n",
+                  "%.3f +- %.3f, heading bias %.1f +- %.1f deg, %d epochs, baseline %.0f m, residual autocorrelation time %.1f epochs%s\n",
                   r.cal_fit.scale, r.cal_fit.scale_sigma, rad_to_deg(r.cal_fit.heading_bias_rad),
-                  rad_to_deg(r.cal_fit.heading_bias_sigma_rad), r.cal_fit.epochs, r.cal_fit.baseline_m, r.cal_fit.residual_rho,
+                  rad_to_deg(r.cal_fit.heading_bias_sigma_rad), r.cal_fit.epochs, r.cal_fit.baseline_m, r.cal_fit.residual_tau,
                   calibration_note(r.cal_fit).c_str());
     std::fflush(stdout);
     results.push_back(r);

@@ -163,7 +163,9 @@ TEST(PdrCalibrator, CourseOverGroundPinsTheHeadingBiasWhenPositionsCannot) {
     EXPECT_EQ(pos.course_epochs, 0);
     EXPECT_GT(both.course_epochs, 60);
     EXPECT_LT(both.course_epochs, 176);  // the turning epochs (4-5 turns, 2-5 s each) are refused
-    EXPECT_LT(both.heading_bias_sigma_rad, 0.6 * pos.heading_bias_sigma_rad);
+    EXPECT_LT(both.heading_bias_sigma_rad, 0.9 * pos.heading_bias_sigma_rad);
+    EXPECT_LE(both.heading_bias_sigma_rad, both.course_bias_sigma_rad);  // never worse than either alone
+    EXPECT_LT(both.heading_bias_sigma_rad, 3.0 * kDegToRad);
     EXPECT_NEAR(both.heading_bias_rad, w.true_bias_rad, 2.0 * kDegToRad);
     // honest: the truth inside 3 sigma
     EXPECT_LT(std::abs(both.heading_bias_rad - w.true_bias_rad), 3.0 * both.heading_bias_sigma_rad);
@@ -240,6 +242,57 @@ TEST(PdrCalibrator, CourseSamplesLeaveTheWindowWithThePositions) {
     if (k == 300) EXPECT_GT(cal.calibration().course_epochs, 90);
   }
   EXPECT_EQ(cal.calibration().course_epochs, 0);
+}
+
+// A chipset's course is smoothed (its velocity filter): samples 1 s apart correlate over many
+// seconds, rho(1) near 1, and decorrelate. Here 240 s of a straight walk whose course error is
+// the moving average of 20 uniform draws (not the calibrator's model), scaled so that each
+// sample's spread is the sigma the calibrator states for it. Over 400 walks the course fit's
+// sigma covers its error 76 % of the time (the halves' drift test adds a little); the AR(1)
+// effective sample size from rho(1) (0.95 here: 39 samples a sample) covered 86 %.
+TEST(PdrCalibrator, ASmoothedCourseIsCountedByItsMeasuredAutocorrelation) {
+  constexpr int kWalks = 400, kMa = 20;
+  constexpr double kSpeed = 1.4;  // m/s: 0.7 m steps every 0.5 s
+  const double stated = std::atan2(PdrCalibrationOptions{}.course_velocity_sigma_mps, kSpeed);
+  int covered = 0;
+  double ratio_sum = 0.0;
+  for (int walk = 0; walk < kWalks; ++walk) {
+    std::mt19937_64 rng(1000 + walk);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<double> draws;
+    PdrCalibrator cal;
+    const double bias = 5.0 * kDegToRad;
+    for (int k = 0; k < 480; ++k) {
+      PdrStep s;
+      s.t_ns = k * 500 * kNsPerMs;
+      s.length_m = 0.7;
+      s.heading_rad = 0.5 + bias;
+      cal.add_step(s);
+      if (k % 2 == 1) {
+        draws.push_back(u(rng));
+        if (draws.size() > kMa) draws.erase(draws.begin());
+        double ma = 0.0;
+        for (double d : draws) ma += d;
+        // a uniform draw's sigma is 1/sqrt(3); the mean of kMa of them 1/sqrt(3 kMa)
+        const double err = ma / static_cast<double>(draws.size()) * std::sqrt(3.0 * static_cast<double>(draws.size())) * stated;
+        cal.add_course(s.t_ns, 0.5 + err, kSpeed, std::nan(""));
+        // positions far too noisy to matter: the course alone decides the heading
+        const double d = 0.7 * (k + 1);
+        cal.add_gnss(s.t_ns, Eigen::Vector2d(d * std::sin(0.5), d * std::cos(0.5)), 1000.0);
+      }
+    }
+    const PdrCalibration& c = cal.calibration();
+    ASSERT_GT(c.course_epochs, 200) << walk;
+    ASSERT_GT(c.course_bias_sigma_rad, 0.0) << walk;
+    const double z = std::abs(c.course_bias_rad - bias) / c.course_bias_sigma_rad;
+    covered += z <= 1.0 ? 1 : 0;
+    ratio_sum += c.course_bias_sigma_rad / stated;
+  }
+  const double coverage = static_cast<double>(covered) / kWalks;
+  std::printf("course fit: error within its 1-sigma on %.3f of %d walks; sigma %.3f x a sample's\n", coverage, kWalks,
+              ratio_sum / kWalks);
+  EXPECT_GT(coverage, 0.55);
+  EXPECT_LT(coverage, 0.82);
 }
 
 TEST(PdrCalibrator, StandingStillNeverPublishes) {

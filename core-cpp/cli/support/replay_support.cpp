@@ -308,7 +308,7 @@ nlohmann::json pdr_calibration_json(const fusion::PdrCalibration& c) {
           {"heading_bias_sigma_deg", rad_to_deg(c.heading_bias_sigma_rad)},
           {"window_epochs", c.epochs},
           {"baseline_m", c.baseline_m},
-          {"residual_rho", c.residual_rho},
+          {"residual_tau_epochs", c.residual_tau},
           {"course_epochs", c.course_epochs},
           {"course_bias_deg", rad_to_deg(c.course_bias_rad)},
           {"course_bias_sigma_deg", rad_to_deg(c.course_bias_sigma_rad)},

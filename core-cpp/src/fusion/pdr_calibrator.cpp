@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <vector>
 
 namespace pdnav::fusion {
 
@@ -107,13 +108,36 @@ void PdrCalibrator::reset() {
 }
 
 namespace {
+/// The integrated autocorrelation time (in samples) of a residual series, tau = 1 + 2 sum rho(k),
+/// the sum measured, not extrapolated from rho(1), over Sokal's automatic window: the smallest M
+/// with M >= 5 tau(M) (Sokal 1997, "Monte Carlo methods in statistical mechanics", Sec. 3; c = 5
+/// as there). A smooth series (a chipset's filtered course, a 3 s PDR direction) has rho(1) near
+/// 1 and decorrelates within seconds, where the AR(1) value (1 + rho(1)) / (1 - rho(1)) counted a
+/// whole window as one sample; a long tail (multipath) counts in full. Complex residuals
+/// (positions) correlate through Re(conj(r_i) r_i+k). 1 for fewer than 3 samples.
+double autocorrelation_time(const std::vector<std::complex<double>>& r) {
+  const std::size_t n = r.size();
+  double c0 = 0.0;
+  for (const auto& x : r) c0 += std::norm(x);
+  if (n < 3 || !(c0 > 0.0)) return 1.0;
+  double tau = 1.0;
+  for (std::size_t k = 1; k < n; ++k) {
+    double c = 0.0;
+    for (std::size_t i = k; i < n; ++i) c += std::real(std::conj(r[i - k]) * r[i]);
+    tau += 2.0 * c / c0;
+    if (static_cast<double>(k) >= 5.0 * tau) break;
+  }
+  return std::clamp(tau, 1.0, static_cast<double>(n));
+}
+
 /// The effective number of independent samples of a time-correlated series (GNSS errors:
 /// multipath, a chipset's own filter; PDR drift): the smaller of moving time / correlation time
-/// and the AR(1) value n (1 - rho) / (1 + rho) from the residuals' lag-1 autocorrelation rho
-/// (Bayley & Hammersley 1946), so a run of smoothed fixes is never counted as many.
-double effective_samples(double n, double moving_s, double rho, const PdrCalibrationOptions& opt) {
-  const double n_eff_ar = opt.residual_correlation ? n * (1.0 - rho) / (1.0 + rho) : n;
-  return std::clamp(std::min(moving_s / opt.correlation_time_s + 1.0, n_eff_ar), 1.0, n);
+/// and n / tau from the residuals' integrated autocorrelation time (von Storch & Zwiers 1999,
+/// Sec. 17.1.3, as the GNSS filter's fix scale), so a run of smoothed fixes is never counted as
+/// many.
+double effective_samples(double n, double moving_s, double tau, const PdrCalibrationOptions& opt) {
+  const double n_eff_ac = opt.residual_correlation ? n / tau : n;
+  return std::clamp(std::min(moving_s / opt.correlation_time_s + 1.0, n_eff_ac), 1.0, n);
 }
 
 /// A heading bias fitted over a window and over its two halves (a: older, b: recent). Their
@@ -170,17 +194,16 @@ SeriesFit fit_series(It b, It e, const PdrCalibrationOptions& opt, bool circular
     if (x != b) moving_s += std::min(opt.correlation_time_s, static_cast<double>(x->t_ns - std::prev(x)->t_ns) * 1e-9);
   }
   f.mean = circular ? std::arg(sum) : lin / w_sum;
-  double chi2 = 0.0, r0 = 0.0, r1 = 0.0, prev = 0.0;
+  double chi2 = 0.0;
+  std::vector<std::complex<double>> res;
+  res.reserve(static_cast<std::size_t>(n));
   for (It x = b; x != e; ++x) {
     const double r = circular ? std::remainder(x->value - f.mean, 2.0 * kPi) : x->value - f.mean;
     chi2 += x->w * r * r;
-    r0 += r * r;
-    if (x != b) r1 += prev * r;
-    prev = r;
+    res.emplace_back(r, 0.0);
   }
-  const double rho = r0 > 0.0 ? std::clamp(r1 / r0, 0.0, 0.999) : 0.0;
   const double var_factor = std::max(1.0, chi2 / (n - 1.0));
-  f.var = var_factor / w_sum * (n / effective_samples(n, moving_s, rho, opt));
+  f.var = var_factor / w_sum * (n / effective_samples(n, moving_s, autocorrelation_time(res), opt));
   f.ok = true;
   return f;
 }
@@ -189,7 +212,7 @@ struct RangeFit {
   bool ok = false;
   std::complex<double> gain = 0.0;
   double var_component = 0.0;  // of Re c and of Im c
-  double baseline_m = 0.0, rho = 0.0, span_s = 0.0, moving_s = 0.0;
+  double baseline_m = 0.0, tau = 1.0, span_s = 0.0, moving_s = 0.0;
 };
 }  // namespace
 
@@ -227,19 +250,17 @@ static RangeFit fit_range(It b, It e, const PdrCalibrationOptions& opt) {
   f.gain = spg / spp;
   // variance factor from the residuals (2 n observations, 4 parameters), never below 1:
   // the weights are the GNSS sigmas, residuals can only say they were optimistic
-  double chi2 = 0.0, r0 = 0.0, r1 = 0.0;
-  std::complex<double> prev = 0.0;
+  double chi2 = 0.0;
+  std::vector<std::complex<double>> res;
+  res.reserve(static_cast<std::size_t>(n));
   for (It x = b; x != e; ++x) {
-    const std::complex<double> res = x->g - g_mean - f.gain * (x->p - p_mean);
-    chi2 += x->w * std::norm(res);
-    r0 += std::norm(res);
-    if (x != b) r1 += std::real(std::conj(prev) * res);
-    prev = res;
+    res.push_back(x->g - g_mean - f.gain * (x->p - p_mean));
+    chi2 += x->w * std::norm(res.back());
   }
   const double dof = std::max(1.0, 2.0 * n - 4.0);
   const double var_factor = std::max(1.0, chi2 / dof);
-  f.rho = r0 > 0.0 ? std::clamp(r1 / r0, 0.0, 0.999) : 0.0;
-  f.var_component = var_factor / spp * (n / effective_samples(n, f.moving_s, f.rho, opt));
+  f.tau = autocorrelation_time(res);
+  f.var_component = var_factor / spp * (n / effective_samples(n, f.moving_s, f.tau, opt));
   f.ok = true;
   return f;
 }
@@ -251,7 +272,7 @@ void PdrCalibrator::fit() {
   const RangeFit f = fit_range(window_.begin(), window_.end(), opt_);
   c.baseline_m = f.baseline_m;
   c.span_s = f.span_s;
-  c.residual_rho = f.rho;
+  c.residual_tau = f.tau;
   if (f.ok) {
     const std::complex<double> gain = f.gain;
     const double var_component = f.var_component;

@@ -23,7 +23,7 @@ struct PdrCalibrationOptions {
   double min_baseline_m = 20.0;       // RMS spread of the PDR track in the window before publishing
   int min_epochs = 20;                // GNSS epochs in the window before publishing
   double correlation_time_s = 10.0;   // GNSS error correlation (multipath): N_eff <= time moving / this
-  bool residual_correlation = true;   // N_eff also <= the AR(1) value of the residuals (pdr_calibrator.cpp)
+  bool residual_correlation = true;   // N_eff also <= N / the residuals' integrated autocorrelation time
   bool check_bias_drift = true;       // fit the two halves of the window: how far the bias moved
   bool independent_heading = true;    // false: one publication test on both sigmas (before issue 28)
   /// Published when it knows the scale and the heading bias better than the fused filter's
@@ -39,7 +39,7 @@ struct PdrCalibrationOptions {
   /// inverse variance. Without a stated bearing accuracy its sigma is the velocity error over
   /// the speed, atan(course_velocity_sigma_mps / speed): 0.3 m/s (measured on the shared ETH
   /// walk: the bearing scatters 5-16 deg about the PDR direction at 1.0-1.2 m/s). The samples are
-  /// time-correlated like the positions (correlation_time_s, AR(1) of their residuals).
+  /// time-correlated like the positions (correlation_time_s, their residuals' autocorrelation).
   bool use_course = true;
   double course_velocity_sigma_mps = 0.3;
   double course_min_speed_mps = 0.6;      // below this a walker's course is mostly noise
@@ -66,7 +66,7 @@ struct PdrCalibration {
   bool heading_applied = true;        // false: the heading fit was too uncertain, bias 0 +- the prior
   int epochs = 0;                     // GNSS epochs in the window
   double baseline_m = 0.0;            // RMS spread of the PDR track in the window
-  double residual_rho = 0.0;          // lag-1 autocorrelation of the fit residuals (N_eff)
+  double residual_tau = 1.0;          // integrated autocorrelation time of the fit residuals, epochs (N_eff = N / tau)
   double span_s = 0.0;                // time from the first to the last epoch of the window
   /// How far the heading bias moved within the window: the two halves of the PDR path fitted
   /// separately differ by this beyond their own sigmas (0 when they agree).
