@@ -191,14 +191,6 @@ struct WalkResult {
   std::map<TimeNs, double> ref_sigma_m;  // --reference fixes: per-axis 1-sigma of each fix
 };
 
-double median(std::vector<double> v) {
-  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
-  if (v.empty()) return kNaN;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 /// Linear-interpolated percentile (0-100) of the finite values.
 double percentile(std::vector<double> v, double pct) {
   v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
@@ -860,10 +852,10 @@ nlohmann::json walk_json(const WalkResult& r, const EvalPdrArgs& a) {
   j["length_ratio"] = num(r.length_ratio);
   j["naive_length_ratio"] = num(r.naive_ratio);
   j["segments"] = r.seg_heading_err_deg.size();
-  j["seg_heading_signed_median_deg"] = num(median(r.seg_heading_err_deg));
-  j["seg_heading_abs_median_deg"] = num(median(abs_h));
-  j["naive_seg_heading_signed_median_deg"] = num(median(r.naive_seg_heading_err_deg));
-  j["naive_seg_heading_abs_median_deg"] = num(median(naive_abs_h));
+  j["seg_heading_signed_median_deg"] = num(median_of_finite(r.seg_heading_err_deg));
+  j["seg_heading_abs_median_deg"] = num(median_of_finite(abs_h));
+  j["naive_seg_heading_signed_median_deg"] = num(median_of_finite(r.naive_seg_heading_err_deg));
+  j["naive_seg_heading_abs_median_deg"] = num(median_of_finite(naive_abs_h));
   j["seg_heading_err_deg"] = r.seg_heading_err_deg;
   j["naive_seg_heading_err_deg"] = r.naive_seg_heading_err_deg;
   j["seg_heading_sigma_deg"] = r.seg_heading_sigma_deg;
@@ -919,7 +911,7 @@ int run_eval_pdr(const EvalPdrArgs& a) {
     std::printf("%-48s wps %2zu steps %4lld mean_err_m %6.2f max %6.2f ratio %5.3f seg_heading_median %+5.1f | ",
                 r.name.c_str(), r.errors_m.size() + 1, static_cast<long long>(r.steps), r.mean_m,
                 *std::max_element(r.errors_m.begin(), r.errors_m.end()), r.length_ratio,
-                median(r.seg_heading_err_deg));
+                median_of_finite(r.seg_heading_err_deg));
     if (std::isfinite(r.naive_mean_m)) std::printf("naive %6.2f ratio %5.3f\n", r.naive_mean_m, r.naive_ratio);
     else std::printf("naive n/a (no rotation vector: its heading)\n");
     if (r.reference == "fixes")
@@ -949,14 +941,14 @@ int run_eval_pdr(const EvalPdrArgs& a) {
   const bool any_naive = std::any_of(naive_means.begin(), naive_means.end(), [](double v) { return std::isfinite(v); });
   if (any_naive)
     std::printf("walks %zu (failed %d); better than naive in %d; naive median_mean_error_m %.2f\n", all.size(), failed, wins,
-                median(naive_means));
+                median_of_finite(naive_means));
   else
     std::printf("walks %zu (failed %d); naive PDR n/a (no walk has a rotation vector)\n", all.size(), failed);
   std::printf("segment heading error: median signed %.1f deg, median |.| %.1f deg over %zu segments; WMM declination %.1f deg\n",
-              median(herr), median(abs_herr), herr.size(), all.front().declination_deg);
+              median_of_finite(herr), median_of_finite(abs_herr), herr.size(), all.front().declination_deg);
   if (any_naive)
     std::printf("naive (rotation vector +Y, magnetic, no declination): segment heading error median signed %.1f deg\n",
-                median(naive_herr));
+                median_of_finite(naive_herr));
   std::int64_t h_within = 0, h_stated = 0;
   std::vector<double> h_sigma;
   for (const auto& r : all) {
@@ -967,7 +959,7 @@ int run_eval_pdr(const EvalPdrArgs& a) {
   if (h_stated > 0)
     std::printf("heading segments whose error is within their steps' stated 1-sigma (median %.1f deg): %.3f of %lld "
                 "(honest: 0.68)\n",
-                median(h_sigma), static_cast<double>(h_within) / static_cast<double>(h_stated), static_cast<long long>(h_stated));
+                median_of_finite(h_sigma), static_cast<double>(h_within) / static_cast<double>(h_stated), static_cast<long long>(h_stated));
   std::int64_t qsf_tested = 0, qsf_static = 0;
   for (const auto& r : all) qsf_tested += r.qsf_tested, qsf_static += r.qsf_static;
   if (qsf_tested > 0)
@@ -982,8 +974,8 @@ int run_eval_pdr(const EvalPdrArgs& a) {
       over += r.waving_steps > 2;
     }
     std::printf("waving (%.0f s, seed %llu, amplitude %.2f): steps out before the walk: median %.0f, max %.0f, walks with > 2: %d of %zu (naive: median %.0f)\n",
-                a.wave_s, static_cast<unsigned long long>(a.wave_seed), a.wave_amplitude, median(ws),
-                percentile(ws, 100), over, all.size(), median(nws));
+                a.wave_s, static_cast<unsigned long long>(a.wave_seed), a.wave_amplitude, median_of_finite(ws),
+                percentile(ws, 100), over, all.size(), median_of_finite(nws));
   }
   std::int64_t cs = 0, c68 = 0, c1 = 0;
   for (const auto& r : all) cs += r.cov_scored, c68 += r.cov_inside_68, c1 += r.cov_inside_1sigma;
@@ -993,7 +985,7 @@ int run_eval_pdr(const EvalPdrArgs& a) {
                 static_cast<double>(c1) / static_cast<double>(cs));
   std::printf("per-walk mean error: p25 %.2f m, p75 %.2f m, max %.2f m\n", percentile(means, 25), percentile(means, 75),
               percentile(means, 100));
-  std::printf("median_mean_error_m: %.2f median_length_ratio: %.3f\n", median(means), median(ratios));
+  std::printf("median_mean_error_m: %.2f median_length_ratio: %.3f\n", median_of_finite(means), median_of_finite(ratios));
   return failed ? 1 : 0;
 }
 
