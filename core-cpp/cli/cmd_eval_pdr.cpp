@@ -170,6 +170,8 @@ struct WalkResult {
   std::vector<double> errors_m, naive_errors_m, seg_heading_err_deg, naive_seg_heading_err_deg;
   // per segment: the RMS of the stated heading 1-sigma of the steps in it (NaN: no step)
   std::vector<double> seg_heading_sigma_deg;
+  // per segment: its middle, s after the walk's first Truth line (the heading error as a time series)
+  std::vector<double> seg_mid_s;
   double mean_m = kNaN, naive_mean_m = kNaN, length_ratio = kNaN, naive_ratio = kNaN;
   std::int64_t steps = 0;
   double declination_deg = kNaN;
@@ -725,6 +727,7 @@ WalkResult eval_walk(const std::string& path, const EvalPdrArgs& a, const std::s
         const Eigen::Vector2d dt = tr - truth_en[seg_start];
         r.seg_heading_err_deg.push_back(segment_heading_error_deg(dt, est - est_en[seg_start]));
         r.seg_heading_sigma_deg.push_back(rms_step_sigma_deg(run, truth_t[seg_start], t->t_ns));
+        r.seg_mid_s.push_back(0.5 * ns_to_s(truth_t[seg_start] + t->t_ns - 2 * truth_t.front()));
         // the same for the naive PDR = the phone's own (magnetic) rotation-vector heading of +Y:
         // separates what the map frame and the field give from what our fusion adds
         r.naive_seg_heading_err_deg.push_back(segment_heading_error_deg(dt, naive.pos_en() - naive_en[seg_start]));
@@ -859,6 +862,7 @@ nlohmann::json walk_json(const WalkResult& r, const EvalPdrArgs& a) {
   j["seg_heading_err_deg"] = r.seg_heading_err_deg;
   j["naive_seg_heading_err_deg"] = r.naive_seg_heading_err_deg;
   j["seg_heading_sigma_deg"] = r.seg_heading_sigma_deg;
+  j["seg_mid_s"] = r.seg_mid_s;
   const auto [within, stated] = heading_within_sigma(r);
   j["seg_heading_stated"] = stated;
   j["seg_heading_within_sigma"] = stated > 0 ? num(static_cast<double>(within) / static_cast<double>(stated)) : nlohmann::json(nullptr);

@@ -25,6 +25,7 @@
 #include "pdnav/terrain/dem.h"
 #include "pdnav/terrain/simulator.h"
 #include "pdnav/terrain/terrain_engine.h"
+#include "support/eval_support.h"
 #include "support/replay_support.h"
 #include "support/walk_log.h"
 
@@ -124,13 +125,6 @@ AppWalkResult evaluate_app_path(const terrain::SimulatedWalk& walk, const EvalAr
   return out;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t m = v.size() / 2;
-  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
-}
-
 int run_eval(const EvalArgs& a) {
   if (a.walks < 1) throw std::invalid_argument("--walks must be >= 1");
   if (a.path != "app" && a.path != "direct") throw std::invalid_argument("--path must be app or direct");
@@ -203,7 +197,9 @@ int run_eval(const EvalArgs& a) {
               epochs ? static_cast<double>(inside_unit) / static_cast<double>(epochs) : 0.0);
   std::printf("# terrain status over the epochs: %lld ambiguous, %lld uninformative\n",
               static_cast<long long>(ambiguous), static_cast<long long>(uninformative));
-  std::printf("median_ratio: %.3f coverage: %.3f\n", median(ratios), coverage);
+  // a walk whose ratio is not finite has already made the run fail (exit 3, "finite: NO"); the
+  // median is of the finite ones (sorting a NaN is undefined)
+  std::printf("median_ratio: %.3f coverage: %.3f\n", median_of_finite(ratios), coverage);
   return finite ? 0 : 3;
 }
 

@@ -126,6 +126,17 @@ add_test(NAME pdr_cli_eval_pdr_write_logs_names
                  "${PROJECT_BINARY_DIR}/test-scratch/pdr-written-names")
 set_tests_properties(pdr_cli_eval_pdr_write_logs_names PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_ilc
                      PASS_REGULAR_EXPRESSION "b/x\\.log is written as x-2\\.log \\(another input has its name\\)\nx-2\\.log\nx\\.log\nrc=1\ninput-intact")
+# eval-pdr --json: each heading segment's middle time (seg_mid_s), the heading error as a time
+# series (docs/results.md: the heading error's structure function against the fused filter's
+# Gauss-Markov heading bias)
+add_test(NAME pdr_cli_eval_pdr_segment_times
+         COMMAND sh -c "j=\"$1\"; shift; mkdir -p \"$(dirname \"$j\")\" || exit 1; \"$0\" eval-pdr --quiet --json \"$j\" \"$@\" >/dev/null || exit 1; /usr/bin/python3 \"${PROJECT_SOURCE_DIR}/tests/pdr/check_segment_times.py\" \"$j\" \"$@\""
+                 $<TARGET_FILE:pdnav> "${PROJECT_BINARY_DIR}/test-scratch/pdr-segment-times.jsonl"
+                 "${_pdr_ilc_out}/site2_F3_5dd38fff44333f00067aa387.log"
+                 "${_pdr_ilc_out}/site2_F3_5dd398c544333f00067aa431.log"
+                 "${_pdr_ilc_out}/site1_F4_5ddb656fc5b77e0006b1792e.log")
+set_tests_properties(pdr_cli_eval_pdr_segment_times PROPERTIES LABELS "pdr;cli" FIXTURES_REQUIRED pdr_ilc
+                     PASS_REGULAR_EXPRESSION "\nsegment times ok")
 # Issue 27: two TYREX motion-capture recordings converted by tools/tyrex2log (steps counted from
 # the capture: the slow texting walk ~1.15 Hz, the run 2.72 Hz, matching the phone's own
 # accelerometer spectrum; the count within 10 % of the two independent counts it prints, the
