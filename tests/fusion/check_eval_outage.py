@@ -99,6 +99,16 @@ def main(argv):
     if abs(js["outage_ratio"] - ratio) > 1e-3 or abs(js["coverage_68"] - cov) > 1e-3:
         failures.append("JSON figures differ from the bar line")
     inw = [x for x in rows if x["in_window"] == "1"]
+    # the window's median squared Mahalanobis distance (the CSV's, in the window) and its chi^2(2)
+    # percentile, in the JSON and on the printed line
+    m2 = sorted(float(x["fused_mahalanobis2"]) for x in inw if math.isfinite(float(x["fused_mahalanobis2"])))
+    m2_med = (m2[len(m2) // 2] if len(m2) % 2 else 0.5 * (m2[len(m2) // 2 - 1] + m2[len(m2) // 2])) if m2 else float("nan")
+    pct = re.search(r"window_median_percentile: (\S+)", r.stdout)
+    if (not m2 or abs(js["median_mahalanobis2"] - m2_med) > 2e-4 * max(1.0, m2_med)
+            or abs(js["median_percentile"] - 100.0 * (1.0 - math.exp(-0.5 * m2_med))) > 0.05
+            or not pct or abs(float(pct.group(1)) - js["median_percentile"]) > 0.051):
+        failures.append(f"window median Mahalanobis^2 {js.get('median_mahalanobis2')} / percentile "
+                        f"{js.get('median_percentile')} (printed {pct.group(1) if pct else None}) against the CSV's {m2_med}")
     if len(inw) != n_ep:
         failures.append(f"CSV has {len(inw)} rows in the window, printed {n_ep}")
     fe = [float(x["fused_err_m"]) for x in inw]
