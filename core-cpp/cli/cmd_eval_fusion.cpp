@@ -159,6 +159,9 @@ struct WalkResult {
   double outage_ratio = kNaNd, open_sky_ratio = kNaNd, max_jump_sigma = 0.0, reacquire_s = kNaNd;
   double gnss_back_s = kNaNd;  // GNSS-only valid again this long after the scripted outage's end
   int out_covered_68 = 0, out_scored = 0;  // outage epochs with truth inside the fused 68 % region / scored
+  // the outage's median squared Mahalanobis distance as a chi^2(2) percentile (50 = calibrated):
+  // one outage's error is correlated over minutes, its coverage near 0 or 1 (as eval-outage)
+  double out_median_percentile = kNaNd;
   bool reacquire_censored = false;
   std::pair<double, double> cal_dr{kNaNd, kNaNd}, cal_fused{kNaNd, kNaNd};
   phonesim::SessionStats stats;
@@ -213,12 +216,15 @@ WalkResult evaluate(const phonesim::PhoneSession& ses, const fusion::NavigatorCo
   r.outage_ratio = r.out[0].drms_m / r.out[1].drms_m;
   // Consistency of the fused covariance in the outage: truth inside its 68.27 % ellipse
   // (Mahalanobis^2 <= kOneSigmaM2; docs/results.md "Coverage definitions").
+  std::vector<double> out_m2;
   for (const std::size_t k : out_idx) {
     if (k >= fused.valid.size() || !fused.valid[k]) continue;
     ++r.out_scored;
     const double m2 = mahalanobis2(fused.cov[k], fused.en_m[k] - truth[k].en_m);
     if (std::isfinite(m2) && m2 <= kOneSigmaM2) ++r.out_covered_68;
+    if (std::isfinite(m2)) out_m2.push_back(m2);
   }
+  r.out_median_percentile = 100.0 * (1.0 - std::exp(-0.5 * median_of_finite(out_m2)));  // the chi^2(2) CDF
   r.open_sky_ratio = r.open[0].drms_m / r.open[2].drms_m;
   // Largest jump of the shown position between consecutive epochs, beyond the true motion,
   // in sigma of the two epochs' combined covariance.
@@ -345,7 +351,7 @@ int run_eval_fusion(const EvalFusionArgs& a) {
   if (static_cast<int>(results.size()) < a.walks)
     throw std::runtime_error("eval-fusion: only " + std::to_string(results.size()) + " of " + std::to_string(a.walks) +
                              " walks could be simulated");
-  std::vector<double> ratio, jump, reacq, open, e_out[5], e_after[5];
+  std::vector<double> ratio, jump, reacq, open, percentile, e_out[5], e_after[5];
   int covered = 0, scored = 0;
   std::int64_t scale_used = 0, scale_refused = 0;
   for (const auto& r : results) {
@@ -354,6 +360,7 @@ int run_eval_fusion(const EvalFusionArgs& a) {
     covered += r.out_covered_68;
     scored += r.out_scored;
     ratio.push_back(r.outage_ratio);
+    percentile.push_back(r.out_median_percentile);
     jump.push_back(r.max_jump_sigma);
     reacq.push_back(r.reacquire_s);
     open.push_back(r.open_sky_ratio);
@@ -382,6 +389,9 @@ int run_eval_fusion(const EvalFusionArgs& a) {
   for (const auto& n : a.nav) std::printf(" %s", n.c_str());
   std::printf(" --outage-min %g --outage-max %g --lead %g --tail %g -o walk.log\n", a.outage_min_min, a.outage_max_min,
               a.lead_s, a.tail_s);
+  std::printf("outage_median_percentile: %s (median over the walks of where each outage's median error falls in its "
+              "stated distribution; 50 = calibrated)\n",
+              f1(median_of_finite(percentile)).c_str());
   const double run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("walks: %zu run_time_s: %.1f fused coverage_68 in outages (pooled): %s\n", results.size(), run_s,
               f3(scored > 0 ? static_cast<double>(covered) / scored : kNaNd).c_str());

@@ -47,6 +47,10 @@ def main(argv):
     dr = re.search(r"median DRMS during outages \(m\): fused (\S+) dr (\S+) gnss (\S+)", r.stdout)
     if not dr or not (0.5 < float(dr.group(2)) < 2000.0):
         failures.append("dead reckoning DRMS during the outages missing or not in (0.5, 2000) m")
+    # where the outages' median errors fall in their stated distributions: a percentile
+    pct = re.search(r"^outage_median_percentile: (\S+) ", r.stdout, re.M)
+    if not pct or not (0.0 <= float(pct.group(1)) <= 100.0):
+        failures.append(f"outage_median_percentile missing or not in [0, 100]: {pct.group(0) if pct else None}")
     failures += check_worst_walk_reproduces(cmd[0], r.stdout)
     if failures:
         sys.exit("FAIL: " + "; ".join(failures))
