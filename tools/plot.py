@@ -400,7 +400,10 @@ def plot_outage(args):
         if meta:
             ax2.set_title(f"in the window: fused RMS {meta['fused']['rms_m']:.1f} m, DR RMS {meta['dr']['rms_m']:.1f} m, "
                           f"ratio {meta['outage_ratio']:.2f}, coverage_68 {meta['coverage_68']:.2f}, "
-                          f"max jump {meta['max_jump_sigma']:.2f} sigma", fontsize=9)
+                          f"max jump {meta['max_jump_sigma']:.2f} sigma"
+                          + (f"\nthe median error at percentile {meta['median_percentile']:.0f} of the stated "
+                             f"distribution (50 = calibrated)" if meta.get("median_percentile") is not None else ""),
+                          fontsize=9)
         ax2.set_xlabel("time since the first GNSS (s)")
         ax2.set_ylabel("m")
         ax2.legend(loc="upper left", fontsize=8)
@@ -424,8 +427,10 @@ def plot_outage_summary(metas, out, title):
     d_rms = np.array([m[1].get("dr", {}).get("rms_m", np.nan) for m in metas], dtype=float)
     ok = np.isfinite(cov) & (n_ep > 0)
     pooled = float(np.sum(cov[ok] * n_ep[ok]) / np.sum(n_ep[ok])) if ok.any() else float("nan")
+    pct = np.array([np.nan if m[1].get("median_percentile") is None else m[1]["median_percentile"] for m in metas],
+                   dtype=float)
     x = np.arange(len(names))
-    fig, (a1, a2, a3) = plt.subplots(3, 1, figsize=(max(7, 0.9 * len(names) + 3), 9), sharex=True)
+    fig, (a1, a2, a3, a4) = plt.subplots(4, 1, figsize=(max(7, 0.9 * len(names) + 3), 11.5), sharex=True)
     a1.bar(x, ratio, color="tab:blue")
     a1.axhline(0.5, color="k", ls="--", lw=0.8, label="bar 0.5")
     a1.axhline(np.nanmedian(ratio), color="tab:red", lw=1.0, label=f"median {np.nanmedian(ratio):.3f}")
@@ -441,8 +446,17 @@ def plot_outage_summary(metas, out, title):
     a3.set_ylim(0, 1.05)
     a3.set_ylabel("inside the 68 % region")
     a3.legend(fontsize=8)
-    a3.set_xticks(x)
-    a3.set_xticklabels(names, rotation=30, ha="right", fontsize=8)
+    # a window's error is correlated over minutes: its coverage is near 0 or 1; where its median
+    # error falls in the stated distribution says how far inside or outside it sat
+    a4.bar(x, pct, color="tab:purple")
+    a4.axhline(50, color="k", ls="--", lw=0.8, label="50 = calibrated")
+    if np.isfinite(pct).any():
+        a4.axhline(np.nanmedian(pct), color="tab:red", lw=1.0, label=f"median {np.nanmedian(pct):.1f}")
+    a4.set_ylim(0, 100)
+    a4.set_ylabel("median error: percentile\nof the stated distribution")
+    a4.legend(fontsize=8)
+    a4.set_xticks(x)
+    a4.set_xticklabels(names, rotation=30, ha="right", fontsize=8)
     a1.set_title(title or f"eval-outage over {len(names)} walks / windows", fontsize=10)
     fig.tight_layout()
     p = os.path.join(out, "outage_summary.png")
