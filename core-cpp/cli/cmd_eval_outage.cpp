@@ -307,7 +307,7 @@ WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std:
     }
   }
   r.median_m2 = median_of_finite(m2_window);
-  r.median_percentile = 100.0 * (1.0 - std::exp(-0.5 * r.median_m2));  // the chi^2(2) CDF
+  r.median_percentile = chi2_2dof_percent(r.median_m2);
   if (n_f > 0) r.fused_rms_m = std::sqrt(s_f / n_f);
   if (n_d > 0) r.dr_rms_m = std::sqrt(s_d / n_d);
   r.ratio = r.fused_rms_m / r.dr_rms_m;

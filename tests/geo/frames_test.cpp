@@ -1,5 +1,8 @@
 #include <cmath>
+#include <limits>
+#include <random>
 
+#include <Eigen/Cholesky>
 #include <gtest/gtest.h>
 
 #include "pdnav/geo/baro.h"
@@ -75,6 +78,31 @@ TEST(Ellipse, FromCovariance) {
   EXPECT_NEAR(e.semi_minor_m, 1.0, 1e-12);
   EXPECT_NEAR(e.orientation_rad, kPi / 2, 1e-12);
   EXPECT_NEAR(ErrorEllipse::scale_for_probability(0.95), 2.4477, 1e-4);
+}
+
+// Where an error falls in its stated 2-D Gaussian: the chi^2(2) CDF in percent, against a
+// Monte Carlo of unit-covariance offsets (fixed seed) and its closed-form points.
+TEST(Ellipse, Chi2TwoDofPercentIsTheShareOfGaussianOffsetsInside) {
+  EXPECT_NEAR(chi2_2dof_percent(kOneSigmaM2), 68.2689, 1e-3);
+  EXPECT_NEAR(chi2_2dof_percent(2.0 * std::log(2.0)), 50.0, 1e-9);
+  EXPECT_EQ(chi2_2dof_percent(0.0), 0.0);
+  EXPECT_EQ(chi2_2dof_percent(std::numeric_limits<double>::infinity()), 100.0);
+  EXPECT_TRUE(std::isnan(chi2_2dof_percent(std::numeric_limits<double>::quiet_NaN())));
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::Matrix2d cov;
+  cov << 4.0, 1.0, 1.0, 2.0;
+  const Eigen::LLT<Eigen::Matrix2d> llt(cov);
+  const int draws = 20000;
+  for (const double m2 : {0.5, 1.386, 3.0}) {
+    int inside = 0;
+    for (int k = 0; k < draws; ++k) {
+      const Eigen::Vector2d d = llt.matrixL() * Eigen::Vector2d(n(rng), n(rng));
+      inside += mahalanobis2(cov, d) <= m2;
+    }
+    // binomial sd at 20000 draws <= 0.36 %: 4 sd
+    EXPECT_NEAR(100.0 * inside / draws, chi2_2dof_percent(m2), 1.5) << "m2 " << m2;
+  }
 }
 
 TEST(Units, Wrap) {

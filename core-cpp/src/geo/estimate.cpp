@@ -57,4 +57,6 @@ double mahalanobis2(const Eigen::Matrix2d& cov, const Eigen::Vector2d& d) {
   return (c * d.x() * d.x() - 2.0 * b * d.x() * d.y() + a * d.y() * d.y()) / det;
 }
 
+double chi2_2dof_percent(double m2) { return 100.0 * (1.0 - std::exp(-0.5 * m2)); }
+
 }  // namespace pdnav

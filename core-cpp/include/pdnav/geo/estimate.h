@@ -40,6 +40,11 @@ inline constexpr double kOneSigmaM2 = 2.295748928898636;
 /// <= 1 means inside the 1-sigma ellipse.
 double mahalanobis2(const Eigen::Matrix2d& cov, const Eigen::Vector2d& d);
 
+/// The probability (percent) that a 2-D Gaussian offset lies inside squared Mahalanobis distance
+/// m2: the chi^2(2) CDF, 1 - exp(-m2 / 2). Where an error falls in its stated distribution
+/// (50 = its median; kOneSigmaM2 -> 68.27); NaN for NaN.
+double chi2_2dof_percent(double m2);
+
 struct Estimate {
   TimeNs t_ns = 0;
   EngineKind engine = EngineKind::kNone;
