@@ -17,6 +17,7 @@
 #include "pdnav/io/sample_source.h"
 #include "pdnav/pdr/pdr.h"
 #include "pdnav/terrain/terrain_engine.h"
+#include "support/eval_support.h"
 #include "support/replay_support.h"
 #include "support/sources.h"
 
@@ -219,6 +220,8 @@ int run_replay(const ReplayArgs& a) {
     std::cout << "drms_m: " << st.drms_m << " rms_e_m: " << st.rms_e_m << " rms_n_m: " << st.rms_n_m
               << " p50_h_m: " << st.p50_h_m << " p95_h_m: " << st.p95_h_m
               << " coverage_1sigma: " << st.coverage_1sigma << " coverage_68: " << st.coverage_68 << "\n";
+    std::cout << "median_error_percentile: " << fixed_or(st.median_percentile, 1, "nan")
+              << " (where the median epoch's error falls in its stated distribution; 50 = calibrated)\n";
   } else if (!rec.epochs().empty()) {
     std::cout << "reference: none (no Truth or GPS Fix lines): no error statistics\n";
   }

@@ -11,8 +11,10 @@ it has signal, route and terrain median <= 60 m over the whole session.
   check_engines_csv.py PDNAV DEM GRAPH NAV SCRATCH_DIR
 """
 import csv
+import json
 import math
 import os
+import re
 import statistics
 import sys
 
@@ -73,6 +75,26 @@ def main(argv):
         d = abs(float(first[0]["err_e_m"]) - float(track[0]["err_e_m"])) + abs(float(first[0]["err_n_m"]) - float(track[0]["err_n_m"]))
         if d > 1e-3:
             failures.append(f"first row: engine error {first[0]['err_e_m']},{first[0]['err_n_m']} vs track {track[0]['err_e_m']},{track[0]['err_n_m']}")
+    # (5) replay's median_error_percentile: the median squared Mahalanobis distance of the track's
+    # errors in their covariances, as the chi^2(2) percentile, printed and in summary.json
+    m2 = []
+    for x in track:
+        if x["err_e_m"] == "":
+            continue
+        a, b, c = float(x["cov_ee_m2"]), float(x["cov_en_m2"]), float(x["cov_nn_m2"])
+        e, n = float(x["err_e_m"]), float(x["err_n_m"])
+        det = a * c - b * b
+        m2.append((c * e * e - 2 * b * e * n + a * n * n) / det if det > 0 and a > 0 else math.inf)
+    pct = 100.0 * (1.0 - math.exp(-0.5 * statistics.median(m2))) if m2 else math.nan
+    with open(os.path.join(out, "summary.json")) as f:
+        js = json.load(f)
+    printed = re.search(r"^median_error_percentile: (\S+) ", r.stdout, re.M)
+    stated = js.get("errors", {}).get("median_percentile")
+    if not printed or stated is None or abs(stated - pct) > 0.5 or abs(float(printed.group(1)) - stated) > 0.051:
+        failures.append(f"median_error_percentile printed {printed.group(1) if printed else None}, summary.json {stated}, "
+                        f"from track.csv {pct:.2f}")
+    else:
+        print(f"median_error_percentile {stated:.1f} (track.csv: {pct:.1f})")
     summary = {}
     for eng, v in sorted(by_engine.items()):
         ok = [e for _, e, s in v if s in ("ok", "degraded")] or [e for _, e, _ in v]

@@ -65,7 +65,8 @@ void ProgressBar::done() {
 
 nlohmann::json ErrorStats::to_json() const {
   return {{"epochs_with_reference", n}, {"drms_m", drms_m}, {"rms_e_m", rms_e_m}, {"rms_n_m", rms_n_m},
-          {"p50_horizontal_m", p50_h_m}, {"p95_horizontal_m", p95_h_m}, {"coverage_1sigma", coverage_1sigma}, {"coverage_68", coverage_68}};
+          {"p50_horizontal_m", p50_h_m}, {"p95_horizontal_m", p95_h_m}, {"coverage_1sigma", coverage_1sigma}, {"coverage_68", coverage_68},
+          {"median_percentile", std::isfinite(median_percentile) ? nlohmann::json(median_percentile) : nlohmann::json(nullptr)}};
 }
 
 double fix_sigma_m(const FixSample& f, double default_accuracy_m) {
@@ -162,12 +163,13 @@ std::string ReplayRecorder::reference_kind() const {
 
 ErrorStats ReplayRecorder::error_stats() const {
   ErrorStats s;
-  std::vector<double> h;
+  std::vector<double> h, m2;
   double se = 0, sn = 0;
   std::int64_t inside = 0, inside68 = 0;
   for (const Epoch& e : epochs_) {
     if (!e.has_ref) continue;
     ++s.n;
+    m2.push_back(std::isnan(e.mahalanobis2) ? std::numeric_limits<double>::infinity() : e.mahalanobis2);
     se += e.err_e_m * e.err_e_m;
     sn += e.err_n_m * e.err_n_m;
     h.push_back(std::hypot(e.err_e_m, e.err_n_m));
@@ -185,6 +187,10 @@ ErrorStats ReplayRecorder::error_stats() const {
   s.p95_h_m = pct(0.95);
   s.coverage_1sigma = static_cast<double>(inside) / n;
   s.coverage_68 = static_cast<double>(inside68) / n;
+  // (a non-positive-definite covariance's infinite distance counts as outside the region)
+  std::sort(m2.begin(), m2.end());
+  const std::size_t k = m2.size();
+  s.median_percentile = chi2_2dof_percent(k % 2 ? m2[k / 2] : 0.5 * (m2[k / 2 - 1] + m2[k / 2]));
   return s;
 }
 

@@ -44,6 +44,10 @@ struct ErrorStats {
   double p95_h_m = 0.0;
   double coverage_1sigma = 0.0;  // inside the 1-sigma ellipse (Mahalanobis <= 1; 39.3 % if consistent)
   double coverage_68 = 0.0;      // inside the 68.27 % ellipse (Mahalanobis^2 <= kOneSigmaM2; 68.3 % if consistent)
+  /// The median squared Mahalanobis distance as a chi^2(2) percentile (50 if consistent): a
+  /// walk's error is correlated over minutes, so its coverage is a few draws; this says how far
+  /// inside (< 50) or outside (> 50) its stated region the typical epoch was
+  double median_percentile = kNaN;
   nlohmann::json to_json() const;
 };
 
