@@ -108,6 +108,7 @@ AppWalkResult evaluate_app_path(const terrain::SimulatedWalk& walk, const EvalAr
     ev.coverage_unit = spf.coverage_1sigma;  // the unit ellipse (39.35 %)
     ev.inside_1sigma = static_cast<std::size_t>(std::lround(spf.coverage_68 * static_cast<double>(spf.n)));
     ev.inside_unit = static_cast<std::size_t>(std::lround(spf.coverage_1sigma * static_cast<double>(spf.n)));
+    ev.median_percentile = spf.median_percentile;
     for (const Epoch& e : pf.epochs()) {
       if (!e.est.en_m.allFinite() || !e.est.cov_en_m2.allFinite()) ev.all_finite = false;
       if (e.est.status == EstimateStatus::kAmbiguous) ++out.ambiguous_epochs;
@@ -153,7 +154,7 @@ int run_eval(const EvalArgs& a) {
               "# Mahalanobis^2 <= 2.296); cov_unit = inside the unit-covariance ellipse (39.35 %% content)\n");
   std::printf("%4s %9s %10s %10s %7s %9s %9s %9s %9s %6s\n", "walk", "length_m", "dr_drms_m", "pf_drms_m", "ratio",
               "coverage", "cov_unit", "final_dr", "final_pf", app ? "ambig" : "recov");
-  std::vector<double> ratios;
+  std::vector<double> ratios, percentiles;
   std::size_t inside = 0, inside_unit = 0, epochs = 0;
   std::int64_t ambiguous = 0, uninformative = 0;
   bool finite = true;
@@ -182,6 +183,7 @@ int run_eval(const EvalArgs& a) {
     uninformative += res.uninformative_epochs;
     const double ratio = ev.pf_drms_m / ev.dr_drms_m;
     ratios.push_back(ratio);
+    percentiles.push_back(ev.median_percentile);
     inside += ev.inside_1sigma;
     inside_unit += ev.inside_unit;
     epochs += ev.epochs;
@@ -197,6 +199,9 @@ int run_eval(const EvalArgs& a) {
               epochs ? static_cast<double>(inside_unit) / static_cast<double>(epochs) : 0.0);
   std::printf("# terrain status over the epochs: %lld ambiguous, %lld uninformative\n",
               static_cast<long long>(ambiguous), static_cast<long long>(uninformative));
+  std::printf("# median over the walks of the median step's error percentile in its stated distribution: %s "
+              "(50 = calibrated; a walk's coverage is a few draws)\n",
+              fixed_or(median_of_finite(percentiles), 1, "-").c_str());
   // a walk whose ratio is not finite has already made the run fail (exit 3, "finite: NO"); the
   // median is of the finite ones (sorting a NaN is undefined)
   std::printf("median_ratio: %.3f coverage: %.3f\n", median_of_finite(ratios), coverage);

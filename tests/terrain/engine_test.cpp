@@ -48,6 +48,12 @@ TEST(TerrainEngine, BeatsDeadReckoningOnSimulatedWalks) {
     ratios.push_back(ev.pf_drms_m / ev.dr_drms_m);
     inside += ev.inside_1sigma;
     epochs += ev.epochs;
+    // the median step's percentile and the 68 % coverage say the same thing at the 68 % point:
+    // more than half of the steps inside the region <=> the median inside it
+    ASSERT_TRUE(ev.median_percentile >= 0.0 && ev.median_percentile <= 100.0) << ev.median_percentile;
+    const double at68 = chi2_2dof_percent(kOneSigmaM2);
+    if (ev.coverage_1sigma > 0.5) EXPECT_LE(ev.median_percentile, at68 + 1e-9) << "walk " << k;
+    if (ev.coverage_1sigma < 0.5) EXPECT_GE(ev.median_percentile, at68 - 1e-9) << "walk " << k;
   }
   EXPECT_LT(median(ratios), 0.5);
   const double coverage = static_cast<double>(inside) / static_cast<double>(epochs);

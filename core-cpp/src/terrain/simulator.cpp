@@ -356,6 +356,8 @@ WalkEvaluation evaluate_walk(const SimulatedWalk& walk, std::shared_ptr<const De
   Eigen::Vector2d dr = walk.declared_start_en;
   std::size_t next_p = 0;
   double sum_dr2 = 0.0, sum_pf2 = 0.0;
+  std::vector<double> m2s;
+  m2s.reserve(walk.steps.size());
   for (std::size_t k = 0; k < walk.steps.size(); ++k) {
     const PdrStep& s = walk.steps[k];
     while (next_p < walk.pressure.size() && walk.pressure[next_p].t_ns <= s.t_ns) pf.feed(walk.pressure[next_p++]);
@@ -370,7 +372,8 @@ WalkEvaluation evaluate_walk(const SimulatedWalk& walk, std::shared_ptr<const De
     }
     sum_pf2 += d_pf.squaredNorm();
     sum_dr2 += d_dr.squaredNorm();
-    const double m2 = mahalanobis2(est.cov_en_m2, d_pf);
+    const double m2 = mahalanobis2(est.cov_en_m2, d_pf);  // finite or +inf (not positive definite)
+    m2s.push_back(m2);
     if (m2 <= kOneSigmaM2) ++ev.inside_1sigma;
     if (m2 <= 1.0) ++ev.inside_unit;
     ++ev.epochs;
@@ -383,6 +386,9 @@ WalkEvaluation evaluate_walk(const SimulatedWalk& walk, std::shared_ptr<const De
     ev.pf_drms_m = std::sqrt(sum_pf2 / n);
     ev.coverage_1sigma = static_cast<double>(ev.inside_1sigma) / n;
     ev.coverage_unit = static_cast<double>(ev.inside_unit) / n;
+    std::sort(m2s.begin(), m2s.end());
+    const std::size_t h = m2s.size() / 2;
+    ev.median_percentile = chi2_2dof_percent(m2s.size() % 2 ? m2s[h] : 0.5 * (m2s[h - 1] + m2s[h]));
   }
   ev.stats = pf.stats();
   return ev;

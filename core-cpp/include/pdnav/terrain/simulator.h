@@ -94,6 +94,10 @@ struct WalkEvaluation {
   std::size_t inside_1sigma = 0;   //   (68.27 % probability content, Mahalanobis^2 <= kOneSigmaM2)
   double coverage_unit = 0.0;      // same for the unit-covariance ellipse (39.35 % content)
   std::size_t inside_unit = 0;
+  /// The median epoch's squared Mahalanobis distance as a chi^2(2) percentile (geo
+  /// chi2_2dof_percent; 50 when the covariance is honest): a walk's error is correlated along it,
+  /// so its coverage is a few draws. NaN without an evaluated epoch.
+  double median_percentile = kNaN;
   bool all_finite = true;          // no NaN / inf in any estimate
   double final_dr_error_m = 0.0;
   double final_pf_error_m = 0.0;
