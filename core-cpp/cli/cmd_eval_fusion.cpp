@@ -222,9 +222,9 @@ WalkResult evaluate(const phonesim::PhoneSession& ses, const fusion::NavigatorCo
     ++r.out_scored;
     const double m2 = mahalanobis2(fused.cov[k], fused.en_m[k] - truth[k].en_m);
     if (std::isfinite(m2) && m2 <= kOneSigmaM2) ++r.out_covered_68;
-    if (std::isfinite(m2)) out_m2.push_back(m2);
+    out_m2.push_back(m2);
   }
-  r.out_median_percentile = chi2_2dof_percent(median_of_finite(out_m2));
+  r.out_median_percentile = chi2_2dof_percent(median_mahalanobis2(std::move(out_m2)));
   r.open_sky_ratio = r.open[0].drms_m / r.open[2].drms_m;
   // Largest jump of the shown position between consecutive epochs, beyond the true motion,
   // in sigma of the two epochs' combined covariance.

@@ -299,14 +299,14 @@ WalkResult evaluate(const std::string& path, const EvalOutageArgs& a, const std:
       const double e = (fused.en_m[k] - ref_en[k]).norm();
       s_f += e * e, ++n_f, r.fused_end_m = e;
       if (std::isfinite(m2[k]) && m2[k] <= kOneSigmaM2) ++r.covered;
-      if (std::isfinite(m2[k])) m2_window.push_back(m2[k]);
+      m2_window.push_back(m2[k]);  // (NaN: no positive definite covariance, outside, as above)
     }
     if (dr.valid[k]) {
       const double e = (dr.en_m[k] - ref_en[k]).norm();
       s_d += e * e, ++n_d, r.dr_end_m = e;
     }
   }
-  r.median_m2 = median_of_finite(m2_window);
+  r.median_m2 = median_mahalanobis2(std::move(m2_window));
   r.median_percentile = chi2_2dof_percent(r.median_m2);
   if (n_f > 0) r.fused_rms_m = std::sqrt(s_f / n_f);
   if (n_d > 0) r.dr_rms_m = std::sqrt(s_d / n_d);

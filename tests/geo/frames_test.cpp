@@ -105,6 +105,19 @@ TEST(Ellipse, Chi2TwoDofPercentIsTheShareOfGaussianOffsetsInside) {
   }
 }
 
+// The median of squared Mahalanobis distances counts a distance that is not finite (no positive
+// definite covariance, a NaN error) as outside every region, as the coverage figures do.
+TEST(Ellipse, MedianMahalanobisCountsNonFiniteDistancesAsOutside) {
+  EXPECT_TRUE(std::isnan(median_mahalanobis2({})));
+  EXPECT_EQ(median_mahalanobis2({3.0, 1.0, 2.0}), 2.0);
+  EXPECT_EQ(median_mahalanobis2({4.0, 1.0, 2.0, 3.0}), 2.5);
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(median_mahalanobis2({0.5, nan, nan}), inf);
+  EXPECT_EQ(median_mahalanobis2({0.5, 1.0, nan}), 1.0);
+  EXPECT_EQ(median_mahalanobis2({0.5, 1.0, 3.0, inf}), 2.0);
+  EXPECT_EQ(chi2_2dof_percent(median_mahalanobis2({nan})), 100.0);
+}
+
 TEST(Units, Wrap) {
   EXPECT_NEAR(wrap_pi(3 * kPi / 2), -kPi / 2, 1e-12);
   EXPECT_NEAR(wrap_pi(-kPi), kPi, 1e-12);

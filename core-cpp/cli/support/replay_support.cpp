@@ -169,7 +169,7 @@ ErrorStats ReplayRecorder::error_stats() const {
   for (const Epoch& e : epochs_) {
     if (!e.has_ref) continue;
     ++s.n;
-    m2.push_back(std::isnan(e.mahalanobis2) ? std::numeric_limits<double>::infinity() : e.mahalanobis2);
+    m2.push_back(e.mahalanobis2);
     se += e.err_e_m * e.err_e_m;
     sn += e.err_n_m * e.err_n_m;
     h.push_back(std::hypot(e.err_e_m, e.err_n_m));
@@ -187,10 +187,7 @@ ErrorStats ReplayRecorder::error_stats() const {
   s.p95_h_m = pct(0.95);
   s.coverage_1sigma = static_cast<double>(inside) / n;
   s.coverage_68 = static_cast<double>(inside68) / n;
-  // (a non-positive-definite covariance's infinite distance counts as outside the region)
-  std::sort(m2.begin(), m2.end());
-  const std::size_t k = m2.size();
-  s.median_percentile = chi2_2dof_percent(k % 2 ? m2[k / 2] : 0.5 * (m2[k / 2 - 1] + m2[k / 2]));
+  s.median_percentile = chi2_2dof_percent(median_mahalanobis2(std::move(m2)));
   return s;
 }
 

@@ -1,5 +1,6 @@
 #include "pdnav/geo/estimate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -58,5 +59,14 @@ double mahalanobis2(const Eigen::Matrix2d& cov, const Eigen::Vector2d& d) {
 }
 
 double chi2_2dof_percent(double m2) { return 100.0 * (1.0 - std::exp(-0.5 * m2)); }
+
+double median_mahalanobis2(std::vector<double> m2) {
+  if (m2.empty()) return std::numeric_limits<double>::quiet_NaN();
+  for (double& x : m2)
+    if (!std::isfinite(x)) x = std::numeric_limits<double>::infinity();
+  std::sort(m2.begin(), m2.end());
+  const std::size_t h = m2.size() / 2;
+  return m2.size() % 2 ? m2[h] : 0.5 * (m2[h - 1] + m2[h]);
+}
 
 }  // namespace pdnav

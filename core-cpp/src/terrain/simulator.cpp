@@ -386,9 +386,7 @@ WalkEvaluation evaluate_walk(const SimulatedWalk& walk, std::shared_ptr<const De
     ev.pf_drms_m = std::sqrt(sum_pf2 / n);
     ev.coverage_1sigma = static_cast<double>(ev.inside_1sigma) / n;
     ev.coverage_unit = static_cast<double>(ev.inside_unit) / n;
-    std::sort(m2s.begin(), m2s.end());
-    const std::size_t h = m2s.size() / 2;
-    ev.median_percentile = chi2_2dof_percent(m2s.size() % 2 ? m2s[h] : 0.5 * (m2s[h - 1] + m2s[h]));
+    ev.median_percentile = chi2_2dof_percent(median_mahalanobis2(std::move(m2s)));
   }
   ev.stats = pf.stats();
   return ev;

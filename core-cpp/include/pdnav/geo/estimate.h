@@ -1,6 +1,7 @@
 // The face every engine shares: Options -> Engine(options, seed) -> feed(...) / estimate().
 #pragma once
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -44,6 +45,12 @@ double mahalanobis2(const Eigen::Matrix2d& cov, const Eigen::Vector2d& d);
 /// m2: the chi^2(2) CDF, 1 - exp(-m2 / 2). Where an error falls in its stated distribution
 /// (50 = its median; kOneSigmaM2 -> 68.27); NaN for NaN.
 double chi2_2dof_percent(double m2);
+
+/// The median of squared Mahalanobis distances, a distance that is not finite (a covariance that
+/// is not positive definite, a NaN error) counted as outside every region (+inf), as the coverage
+/// figures count it; NaN when there is none. chi2_2dof_percent of it: where a walk's typical
+/// error falls in its stated distribution (a walk's errors are correlated, its coverage a few draws).
+double median_mahalanobis2(std::vector<double> m2);
 
 struct Estimate {
   TimeNs t_ns = 0;
